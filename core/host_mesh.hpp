@@ -1,0 +1,58 @@
+#pragma once
+// Host-side triangulated surfaces: generation (icosphere, Evans-Fung biconcave RBC) and topology.
+// Built once on the host, then uploaded into the SoA device buffers (core/buffers.hpp).
+#include <array>
+#include <string>
+#include <vector>
+
+namespace dcm {
+
+using Vec3 = std::array<double, 3>;
+using Tri = std::array<int, 3>;
+
+struct HostMesh {
+  std::vector<Vec3> nodes;      // m
+  std::vector<Tri> triangles;   // counter-clockwise seen from outside: normals point outward
+};
+
+// Node count of an icosphere with k subdivisions: 10*4^k + 2.
+long long icosphere_node_count(int subdivisions);
+
+// Icosahedron subdivided k times (each triangle into four, new nodes projected onto the sphere),
+// radius R, centred at the origin. V = 10*4^k+2, E = 30*4^k, F = 20*4^k. k in 0..8.
+HostMesh make_icosphere(int subdivisions, double radius);
+
+// Evans-Fung biconcave red blood cell (MODEL.md section 1): the icosphere of the same k mapped by
+//   (x, y, z) on the unit sphere -> (D/2 x, D/2 y, sign(z) D |z| (a0 + a1 r^2/4 + a2 r^4/16)),
+// r^2 = x^2 + y^2, which is z(rho) = D sqrt(1 - 4 rho^2/D^2) (a0 + a1 rho^2/D^2 + a2 rho^4/D^4)
+// at rho = D r / 2 (|z| = sqrt(1 - r^2) on the unit sphere). Axis of symmetry: z.
+struct EvansFungShape {
+  double diameter = 7.82e-6;  // D (m)
+  double a0 = 0.0518, a1 = 2.0026, a2 = -4.491;
+  // Half-thickness z(rho) for 0 <= rho <= D/2.
+  double half_thickness(double rho) const;
+};
+HostMesh make_evans_fung(int subdivisions, const EvansFungShape& shape = {});
+
+// Adds a constant offset to every node.
+void translate(HostMesh& mesh, const Vec3& offset);
+
+// Connectivity derived from the triangles. Throws std::runtime_error when the surface is not a closed,
+// consistently oriented 2-manifold (an edge not in exactly two triangles with opposite directions).
+struct Topology {
+  std::vector<std::array<int, 2>> edges;  // bonds, i < j
+  // Hinges: one per edge, (i, j, k, l): the edge i-j, triangle (i, j, k) and triangle (j, i, l), both
+  // as oriented in the mesh; k and l are the opposite nodes.
+  std::vector<std::array<int, 4>> hinges;
+  std::vector<std::array<int, 2>> edge_triangles;  // the two triangles of each edge
+  // CSR: node -> incident triangle corners, packed as 3*triangle + corner.
+  std::vector<int> node_tri_offsets, node_tri_corners;
+  // CSR: node -> incident edges.
+  std::vector<int> node_edge_offsets, node_edges;
+  // CSR: node -> neighbours in cyclic order, counter-clockwise seen from outside (the one-ring).
+  std::vector<int> ring_offsets, ring;
+  int euler_characteristic = 0;  // V - E + F
+};
+Topology build_topology(const HostMesh& mesh);
+
+}  // namespace dcm

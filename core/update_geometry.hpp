@@ -1,0 +1,19 @@
+#pragma once
+// update_geometry(): the geometry stage of a step, kernels in dependency order.
+#include "kernels/curvature.hpp"
+#include "kernels/rounded_triangle.hpp"
+#include "kernels/triangle_geometry.hpp"
+
+namespace dcm {
+
+template <class ExecutionSpace, class MemorySpace>
+void update_geometry(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                     const GeometryBuffers<MemorySpace>& geo, double h_min) {
+  compute_triangle_geometry(space, mesh, geo);
+  compute_cell_measures(space, mesh, geo);
+  compute_node_curvature(space, mesh, geo);
+  compute_triangle_curvature(space, mesh, geo, h_min);
+  compute_rounded_triangles(space, mesh, geo);
+}
+
+}  // namespace dcm
