@@ -47,10 +47,6 @@ struct HostCell {
 template <class MemorySpace>
 MeshBuffers<MemorySpace> upload_cells(const std::vector<HostCell>& cells);
 
-// Positions back on the host, [n_nodes][3] row major.
-template <class MemorySpace>
-std::vector<double> positions_to_host(const MeshBuffers<MemorySpace>& m);
-
 }  // namespace dcm
 
 #include "core/buffers_impl.hpp"

@@ -120,13 +120,4 @@ MeshBuffers<MemorySpace> upload_cells(const std::vector<HostCell>& cells) {
   return b;
 }
 
-template <class MemorySpace>
-std::vector<double> positions_to_host(const MeshBuffers<MemorySpace>& m) {
-  auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), m.x);
-  std::vector<double> out(3 * static_cast<std::size_t>(m.n_nodes));
-  for (int i = 0; i < m.n_nodes; ++i)
-    for (int d = 0; d < 3; ++d) out[3 * i + d] = h(i, d);
-  return out;
-}
-
 }  // namespace dcm

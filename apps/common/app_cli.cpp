@@ -1,0 +1,84 @@
+#include "apps/common/app_cli.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include "core/h5_output.hpp"
+
+namespace dcm {
+
+void add_common_options(CLI::App& app, AppOptions& o) {
+  app.add_option("scene", o.scene_path, "Scene file (TOML); without one the built-in defaults run")
+      ->check(CLI::ExistingFile);
+  app.add_option("--set", o.sets,
+                 "Override a scene key, e.g. --set mesh.nodes=642 --set mesh.shape=evans_fung (repeatable; "
+                 "--list-keys shows every key)")
+      ->type_name("KEY=VALUE");
+  app.add_option("--out", o.out_dir, "Output folder (default: the scene's output.dir, else out/<scene name>)");
+  app.add_option("--threads", o.threads, "Host threads (default: OMP_NUM_THREADS, else all cores)")
+      ->check(CLI::Range(0, 4096));
+  app.add_flag("--quiet", o.quiet, "Print only errors");
+  app.add_flag_callback(
+      "--list-keys",
+      [] {
+        std::cout << scene_schema_markdown();
+        throw CLI::Success();
+      },
+      "Print every scene key with its type, default, unit and allowed range, then exit");
+}
+
+Scene load_scene(const AppOptions& o) {
+  Scene scene = o.scene_path.empty() ? Scene::defaults() : Scene::from_file(o.scene_path);
+  for (const std::string& s : o.sets) scene.set(s);
+  scene.validate();
+  return scene;
+}
+
+std::string prepare_output_dir(const AppOptions& o, const Scene& scene) {
+  namespace fs = std::filesystem;
+  std::string dir = o.out_dir;
+  if (dir.empty()) dir = scene.get_string("output.dir");
+  if (dir.empty()) dir = "out/" + scene.name();
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw IoError(dir + ": cannot create the output folder (" + ec.message() + ")");
+  const fs::path probe = fs::path(dir) / ".dcm-write-test";
+  FILE* f = std::fopen(probe.c_str(), "w");
+  if (!f) throw IoError(dir + ": the output folder is not writable");
+  std::fclose(f);
+  fs::remove(probe, ec);
+  return dir;
+}
+
+int run_app(CLI::App& app, int argc, char** argv, const std::function<void()>& body) {
+  const std::string name = app.get_name();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success&) {
+    return 0;
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << name << ": error: " << e.what() << " (see --help)\n";
+    return 2;
+  }
+  try {
+    body();
+    return 0;
+  } catch (const SceneError& e) {
+    std::cerr << name << ": error: " << e.what() << '\n';
+    return 2;
+  } catch (const IoError& e) {
+    std::cerr << name << ": error: " << e.what() << '\n';
+    return 2;
+  } catch (const NumericalError& e) {
+    std::cerr << name << ": numerical failure: " << e.what() << '\n';
+    return 3;
+  } catch (const std::exception& e) {
+    std::cerr << name << ": internal error: " << e.what() << '\n';
+    return 1;
+  }
+}
+
+}  // namespace dcm

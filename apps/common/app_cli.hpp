@@ -1,0 +1,41 @@
+#pragma once
+// What every dcm app shares on the command line:
+//   <app> [SCENE.toml] [--set key=value]... [--out DIR] [--threads N] [--quiet] [--list-keys]
+// and one policy for failures: a one-line message on stderr and an exit code
+//   2  bad input (command line, scene file, output folder), nothing written;
+//   3  numerical trouble during a run (step, term and node named);
+//   1  anything else (a bug: please report it).
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/scene.hpp"
+
+namespace dcm {
+
+struct AppOptions {
+  std::string scene_path;          // empty: the built-in defaults
+  std::vector<std::string> sets;   // key=value overrides, applied in order after the file
+  std::string out_dir;             // empty: output.dir, else out/<name>
+  int threads = 0;                 // 0: OMP_NUM_THREADS or all cores
+  bool quiet = false;
+};
+
+// Thrown for a failure that exits with code 3 (numerical trouble).
+struct NumericalError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+void add_common_options(CLI::App& app, AppOptions& options);
+
+// The scene from the file (or defaults), with every --set applied, validated. Throws SceneError.
+Scene load_scene(const AppOptions& options);
+
+// --out, else output.dir, else out/<scene name>. Creates it; throws IoError if it cannot be written.
+std::string prepare_output_dir(const AppOptions& options, const Scene& scene);
+
+// Parses the command line and runs body with the failure policy above. Returns the exit code.
+int run_app(CLI::App& app, int argc, char** argv, const std::function<void()>& body);
+
+}  // namespace dcm

@@ -1,0 +1,74 @@
+#include "core/json_writer.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+
+namespace dcm {
+
+std::string json_number(double value) {
+  if (!std::isfinite(value)) return "null";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", value);
+  return buf;
+}
+
+std::string json_string(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", c);
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+JsonObject& JsonObject::add(const std::string& key, double value) {
+  members_.emplace_back(key, json_number(value));
+  return *this;
+}
+JsonObject& JsonObject::add(const std::string& key, long long value) {
+  members_.emplace_back(key, std::to_string(value));
+  return *this;
+}
+JsonObject& JsonObject::add(const std::string& key, const std::string& value) {
+  members_.emplace_back(key, json_string(value));
+  return *this;
+}
+JsonObject& JsonObject::add(const std::string& key, const std::vector<double>& values) {
+  std::string text = "[";
+  for (std::size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + json_number(values[i]);
+  members_.emplace_back(key, text + "]");
+  return *this;
+}
+
+std::string JsonObject::str() const {
+  std::string out = "{\n";
+  for (std::size_t i = 0; i < members_.size(); ++i)
+    out += "  " + json_string(members_[i].first) + ": " + members_[i].second + (i + 1 < members_.size() ? ",\n" : "\n");
+  return out + "}\n";
+}
+
+void JsonObject::write(const std::string& path) const {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp);
+    f << str();
+    if (!f) throw std::runtime_error(path + ": cannot write file");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error(path + ": cannot write file");
+}
+
+}  // namespace dcm

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Configures and builds dcm with a CMake preset (default: release) after making sure the dependencies are
+# there (scripts/deps.sh). Idempotent: a second run only rebuilds what changed.
+#   scripts/build.sh [PRESET] [TARGET...]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+preset=${1:-release}
+shift || true
+kokkos=$(bash scripts/deps.sh | tail -n 1)
+case "$preset" in
+  release) builddir=build ;;
+  debug) builddir=build-debug ;;
+  *) echo "scripts/build.sh: unknown preset '$preset' (release, debug)" >&2; exit 2 ;;
+esac
+if [ ! -f "$builddir/CMakeCache.txt" ] || ! grep -q "^DCM_PRESET:.*=$preset$" "$builddir/CMakeCache.txt"; then
+  cmake --preset "$preset" -DKokkos_ROOT="$kokkos" -DDCM_PRESET="$preset" >&2
+fi
+targets=()
+for t in "$@"; do targets+=(--target "$t"); done
+cmake --build "$builddir" --parallel "$(nproc)" "${targets[@]}" >&2
+echo "$builddir"
