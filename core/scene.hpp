@@ -70,9 +70,22 @@ class Scene {
   std::string origin_ = "defaults";
   std::map<std::string, std::string> values_;  // key -> canonical value text
   std::map<std::string, bool> set_;
+
+  // Stores a checked canonical value; "name" also updates name_ (empty: the name from origin_).
+  void assign(const std::string& key, const std::string& canonical, bool given);
+  // Keeps mesh.nodes and mesh.subdivisions consistent after `key` (one of them) was assigned.
+  void follow_mesh_size(const std::string& key);
 };
 
 // The schema as Markdown (a table per section) for docs/SCENES.md and --help-scene.
 std::string scene_schema_markdown();
+
+namespace detail {
+// Shortest of %.15g, %.16g, %.17g that reads back as v exactly; "nan", "inf", "-inf" for non-finite.
+std::string format_real(double v);
+// What a key allows, as error messages and the Markdown show it: "0 .. 6", "> 0 and ≤ 0.001",
+// "sphere, evans_fung".
+std::string allowed_text(const ParamSpec& spec);
+}  // namespace detail
 
 }  // namespace dcm

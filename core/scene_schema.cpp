@@ -1,0 +1,205 @@
+// The scene schema: every run-time key of dcm with type, default, range, unit and documentation.
+// Cortex, fluid and contact defaults follow Table 1 of Odenthal, Smeets et al. (2013).
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+#include "core/scene.hpp"
+
+namespace dcm {
+namespace {
+
+enum class MinBound { Inclusive, Exclusive };
+
+ParamSpec real_key(const std::string& key, const std::string& def, double min, double max, MinBound bound,
+                   const std::string& unit, const std::string& doc) {
+  ParamSpec s;
+  s.key = key;
+  s.type = ParamType::Real;
+  s.default_value = def;
+  s.min = min;
+  s.max = max;
+  s.has_range = true;
+  s.min_exclusive = bound == MinBound::Exclusive;
+  s.unit = unit;
+  s.doc = doc;
+  return s;
+}
+
+ParamSpec int_key(const std::string& key, const std::string& def, double min, double max,
+                  const std::string& doc) {
+  ParamSpec s;
+  s.key = key;
+  s.type = ParamType::Int;
+  s.default_value = def;
+  s.min = min;
+  s.max = max;
+  s.has_range = true;
+  s.doc = doc;
+  return s;
+}
+
+ParamSpec int_choice_key(const std::string& key, const std::string& def, std::vector<std::string> choices,
+                         const std::string& doc) {
+  ParamSpec s;
+  s.key = key;
+  s.type = ParamType::Int;
+  s.default_value = def;
+  s.choices = std::move(choices);
+  s.doc = doc;
+  return s;
+}
+
+ParamSpec string_key(const std::string& key, const std::string& def, std::vector<std::string> choices,
+                     const std::string& doc) {
+  ParamSpec s;
+  s.key = key;
+  s.type = ParamType::String;
+  s.default_value = def;
+  s.choices = std::move(choices);
+  s.doc = doc;
+  return s;
+}
+
+ParamSpec bool_key(const std::string& key, const std::string& def, const std::string& doc) {
+  ParamSpec s;
+  s.key = key;
+  s.type = ParamType::Bool;
+  s.default_value = def;
+  s.doc = doc;
+  return s;
+}
+
+constexpr MinBound kIncl = MinBound::Inclusive;
+constexpr MinBound kExcl = MinBound::Exclusive;
+
+std::vector<ParamSpec> make_schema() {
+  return {
+      string_key("name", "", {}, "run name; output goes to out/<name> unless output.dir is set"),
+
+      string_key("mesh.shape", "sphere", {"sphere", "evans_fung"},
+                 "sphere = icosphere of radius mesh.radius_m; evans_fung = Evans–Fung biconcave RBC of "
+                 "diameter mesh.diameter_m"),
+      int_key("mesh.subdivisions", "4", 0, 6,
+              "icosphere subdivisions: 0..6 give 12, 42, 162, 642, 2562, 10242, 40962 nodes"),
+      int_choice_key("mesh.nodes", "2562", {"12", "42", "162", "642", "2562", "10242", "40962"},
+                     "node count (10·4^k+2); an alternative to mesh.subdivisions"),
+      real_key("mesh.radius_m", "3.25e-6", 0, 1e-3, kExcl, "m", "radius of the sphere"),
+      real_key("mesh.diameter_m", "7.82e-6", 0, 1e-3, kExcl, "m", "Evans–Fung diameter D"),
+
+      real_key("geometry.h_min_per_m", "1e4", 0, 1e9, kIncl, "1/m",
+               "lower clamp of the triangle mean curvature H (the rounded triangles' radius is at most "
+               "1/H_min)"),
+
+      real_key("cortex.E_Pa", "800e3", 0, 1e9, kExcl, "Pa", "Young's modulus of the cortex (contact law)"),
+      real_key("cortex.nu", "0.4", 0, 0.5, kIncl, "", "Poisson ratio of the cortex"),
+      real_key("cortex.k_s_N_per_m", "3.2e-6", 0, 1, kExcl, "N/m", "FENE+POW spring constant"),
+      real_key("cortex.x_max", "2.05", 1, 10, kExcl, "", "maximum bond extension d_max/d*"),
+      real_key("cortex.c_N_s_per_m", "1.5e-6", 0, 1, kIncl, "N·s/m", "bond dashpot coefficient"),
+      real_key("cortex.k_b_J", "240e-21", 0, 1e-15, kIncl, "J", "bending stiffness"),
+      real_key("cortex.k_a", "6e3", 0, 1e9, kIncl, "see docs/MODEL.md", "local area constraint"),
+      real_key("cortex.k_d", "6e3", 0, 1e9, kIncl, "see docs/MODEL.md", "global area constraint"),
+      real_key("cortex.k_v", "10e3", 0, 1e9, kIncl, "see docs/MODEL.md", "volume constraint"),
+
+      real_key("fluid.eta_Pa_s", "0.8e-3", 0, 10, kExcl, "Pa·s", "viscosity of the medium"),
+
+      real_key("contact.W_J_per_m2", "1e-3", 0, 1, kIncl, "J/m²", "work of adhesion"),
+      real_key("contact.h0_m", "20e-9", 0, 1e-6, kExcl, "m", "range of adhesion (Dugdale)"),
+      real_key("contact.gamma_n_N_s_per_m3", "8e9", 0, 1e15, kIncl, "N·s/m³", "normal substrate friction"),
+      real_key("contact.gamma_t_N_s_per_m3", "6e9", 0, 1e15, kIncl, "N·s/m³",
+               "tangential substrate friction"),
+
+      real_key("time.dt_s", "6e-6", 0, 1, kExcl, "s", "time step"),
+      real_key("time.t_end_s", "1.2", 0, 1e6, kIncl, "s", "simulated time"),
+
+      string_key("output.dir", "", {}, "output directory (empty: out/<name>)"),
+      bool_key("output.hdf5", "true", "write the HDF5 + XDMF output"),
+  };
+}
+
+const char* type_name(ParamType t) {
+  switch (t) {
+    case ParamType::Int: return "integer";
+    case ParamType::Real: return "real";
+    case ParamType::Bool: return "bool";
+    case ParamType::String: return "string";
+  }
+  return "?";
+}
+
+std::string section_of(const std::string& key) {
+  const auto dot = key.find('.');
+  return dot == std::string::npos ? std::string() : key.substr(0, dot);
+}
+
+std::string md_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '|') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
+std::string md_default(const ParamSpec& s) {
+  if (s.type == ParamType::String) return "`\"" + s.default_value + "\"`";
+  return "`" + s.default_value + "`";
+}
+
+std::string md_allowed(const ParamSpec& s) {
+  if (s.type == ParamType::Bool) return "true, false";
+  if (s.choices.empty() && !s.has_range) return "any";
+  return md_escape(detail::allowed_text(s));
+}
+
+}  // namespace
+
+namespace detail {
+
+std::string format_real(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buf[40];
+  for (int precision : {15, 16, 17}) {
+    std::snprintf(buf, sizeof buf, "%.*g", precision, v);
+    if (std::strtod(buf, nullptr) == v) break;
+  }
+  return buf;
+}
+
+std::string allowed_text(const ParamSpec& s) {
+  std::string out;
+  if (!s.choices.empty()) {
+    for (size_t i = 0; i < s.choices.size(); ++i) out += (i ? ", " : "") + s.choices[i];
+    return out;
+  }
+  if (!s.has_range) return "any value";
+  if (s.min_exclusive) return "> " + format_real(s.min) + " and ≤ " + format_real(s.max);
+  return format_real(s.min) + " .. " + format_real(s.max);
+}
+
+}  // namespace detail
+
+const std::vector<ParamSpec>& scene_schema() {
+  static const std::vector<ParamSpec> schema = make_schema();
+  return schema;
+}
+
+std::string scene_schema_markdown() {
+  std::ostringstream os;
+  std::string current = "\x01";  // no section yet
+  for (const ParamSpec& s : scene_schema()) {
+    const std::string section = section_of(s.key);
+    if (section != current) {
+      current = section;
+      os << (os.tellp() > 0 ? "\n" : "") << (section.empty() ? "## Top level" : "## [" + section + "]")
+         << "\n\n| key | type | default | allowed | unit | meaning |\n|---|---|---|---|---|---|\n";
+    }
+    os << "| `" << s.key << "` | " << type_name(s.type) << " | " << md_default(s) << " | " << md_allowed(s)
+       << " | " << md_escape(s.unit) << " | " << md_escape(s.doc) << " |\n";
+  }
+  return os.str();
+}
+
+}  // namespace dcm
