@@ -88,7 +88,7 @@ std::vector<ParamSpec> make_schema() {
       real_key("mesh.radius_m", "3.25e-6", 0, 1e-3, kExcl, "m", "radius of the sphere"),
       real_key("mesh.diameter_m", "7.82e-6", 0, 1e-3, kExcl, "m", "Evans–Fung diameter D"),
 
-      real_key("geometry.h_min_per_m", "1e4", 0, 1e9, kIncl, "1/m",
+      real_key("geometry.h_min_per_m", "1e4", 0, 1e9, kExcl, "1/m",
                "lower clamp of the triangle mean curvature H (the rounded triangles' radius is at most "
                "1/H_min)"),
 
