@@ -14,6 +14,7 @@
 // referencing the datasets above; with no frame written it holds one static grid of /mesh/x.
 // It is rewritten (temporary file + rename) after every frame, and the HDF5 file is flushed, so a run
 // killed between frames leaves both files readable.
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
