@@ -29,6 +29,7 @@ struct MeshBuffers {
   View<int* [4]> hinge;     // (i, j, k, l): triangles (i, j, k) and (j, i, l)
   View<int*> hinge_cell;
   View<int*> cell_node_begin, cell_tri_begin, cell_bond_begin, cell_hinge_begin;  // n_cells + 1
+  std::vector<int> host_cell_node_begin, host_cell_tri_begin;  // the same ranges, for host-side launches
 
   // CSR node adjacency (gather kernels need no atomics).
   View<int*> node_tri_offsets, node_tri_corners;  // corner entries packed as 3 * triangle + corner

@@ -45,6 +45,8 @@ MeshBuffers<MemorySpace> upload_cells(const std::vector<HostCell>& cells) {
       for (std::size_t i = 0; i < v.size(); ++i) h(i) = v[i];
     });
   };
+  b.host_cell_node_begin = nb;
+  b.host_cell_tri_begin = tb;
   b.cell_node_begin = vec_view("cell_node_begin", nb);
   b.cell_tri_begin = vec_view("cell_tri_begin", tb);
   b.cell_bond_begin = vec_view("cell_bond_begin", bb);

@@ -12,10 +12,12 @@ struct GeometryBuffers {
 
   View<double*> tri_area;             // A_t (m^2)
   View<double* [3]> tri_normal;       // unit outward normal n_t
+  View<double* [3]> tri_cot;          // cotangent of the angle at each corner
   View<double*> cell_area;            // A per cell (m^2)
   View<double*> cell_volume;          // V per cell (m^3)
   View<double* [3]> node_curvature;   // K_i, cotangent Laplace-Beltrami mean-curvature vector (1/m)
   View<double*> node_area;            // mixed Voronoi area A_mixed,i (m^2)
+  View<double* [3]> tri_corner_area;  // each corner's share of A_mixed of its node (m^2)
   View<double* [3]> node_normal;      // unit area-weighted normal
   View<double*> node_mean_curvature;  // H_i = sign(K_i . n_i) |K_i| / 2 (1/m)
   View<double*> tri_mean_curvature;   // H_t, Voronoi-weighted mean of its nodes' H, clamped >= H_min
@@ -30,10 +32,12 @@ struct GeometryBuffers {
     };
     a("tri_area", tri_area, m.n_tris);
     a("tri_normal", tri_normal, m.n_tris);
+    a("tri_cot", tri_cot, m.n_tris);
     a("cell_area", cell_area, m.n_cells);
     a("cell_volume", cell_volume, m.n_cells);
     a("node_curvature", node_curvature, m.n_nodes);
     a("node_area", node_area, m.n_nodes);
+    a("tri_corner_area", tri_corner_area, m.n_tris);
     a("node_normal", node_normal, m.n_nodes);
     a("node_mean_curvature", node_mean_curvature, m.n_nodes);
     a("tri_mean_curvature", tri_mean_curvature, m.n_tris);

@@ -12,30 +12,13 @@
 // clamped H_t >= H_min so that flat and concave regions keep a finite "rounded triangle" radius.
 //
 // Expectations (tests/test_curvature.cpp): on an icosphere of radius R with k >= 3, every H_i is within
-// 1% of 1/R and K_i . x_i > 0; a flat patch has K = 0.
+// 1% of 1/R and K_i . x_i > 0; at the Evans-Fung dimple H matches the analytic -2 (a1 - 2 a0) / D.
 #include "core/geometry.hpp"
 #include "core/vec3.hpp"
 
 namespace dcm {
 
-// Cotangent of the angle at corner a of triangle (a, b, c); 0 for a degenerate triangle.
-KOKKOS_INLINE_FUNCTION double cot_at(Real3 a, Real3 b, Real3 c) {
-  const Real3 u = b - a, v = c - a;
-  const double s = norm(cross(u, v));
-  return s > 0 ? dot(u, v) / s : 0.0;
-}
-
-// Meyer's mixed area of corner p in triangle (p, q, r).
-KOKKOS_INLINE_FUNCTION double mixed_area_share(Real3 p, Real3 q, Real3 r) {
-  const double area = 0.5 * norm(cross(q - p, r - p));
-  const bool obtuse_p = dot(q - p, r - p) < 0;
-  const bool obtuse_q = dot(p - q, r - q) < 0;
-  const bool obtuse_r = dot(p - r, q - r) < 0;
-  if (obtuse_p) return 0.5 * area;
-  if (obtuse_q || obtuse_r) return 0.25 * area;
-  return 0.125 * (norm2(r - p) * cot_at(q, r, p) + norm2(q - p) * cot_at(r, p, q));
-}
-
+// Needs compute_triangle_geometry() first (corner cotangents, corner mixed areas, areas, normals).
 template <class ExecutionSpace, class MemorySpace>
 void compute_node_curvature(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                             const GeometryBuffers<MemorySpace>& geo) {
@@ -43,6 +26,10 @@ void compute_node_curvature(const ExecutionSpace& space, const MeshBuffers<Memor
   const auto tri = mesh.tri;
   const auto offsets = mesh.node_tri_offsets;
   const auto corners = mesh.node_tri_corners;
+  const auto cot = geo.tri_cot;
+  const auto corner_area = geo.tri_corner_area;
+  const auto tri_area = geo.tri_area;
+  const auto tri_normal = geo.tri_normal;
   const auto curvature = geo.node_curvature;
   const auto node_area = geo.node_area;
   const auto node_normal = geo.node_normal;
@@ -54,42 +41,40 @@ void compute_node_curvature(const ExecutionSpace& space, const MeshBuffers<Memor
         Real3 sum{0, 0, 0}, area_normal{0, 0, 0};
         double a_mixed = 0;
         for (int s = offsets(i); s < offsets(i + 1); ++s) {
-          const int t = corners(s) / 3, c = corners(s) % 3;
-          const Real3 q = load3(x, tri(t, (c + 1) % 3)), r = load3(x, tri(t, (c + 2) % 3));
-          sum += cot_at(r, p, q) * (p - q) + cot_at(q, r, p) * (p - r);  // eq. 14
-          a_mixed += mixed_area_share(p, q, r);
-          area_normal += cross(q - p, r - p);
+          const int t = corners(s) / 3, c = corners(s) % 3, n = (c + 1) % 3, v = (c + 2) % 3;
+          // eq. 14: edge p-q (q the next corner) faces the previous corner, edge p-r faces the next one
+          sum += cot(t, v) * (p - load3(x, tri(t, n))) + cot(t, n) * (p - load3(x, tri(t, v)));
+          a_mixed += corner_area(t, c);
+          area_normal += tri_area(t) * load3(tri_normal, t);
         }
         const Real3 k = a_mixed > 0 ? (0.5 / a_mixed) * sum : Real3{0, 0, 0};
         const double an = norm(area_normal);
-        const Real3 n = an > 0 ? (1.0 / an) * area_normal : Real3{0, 0, 0};
+        const Real3 nn = an > 0 ? (1.0 / an) * area_normal : Real3{0, 0, 0};
         store3(curvature, i, k);
-        store3(node_normal, i, n);
+        store3(node_normal, i, nn);
         node_area(i) = a_mixed;
-        mean_curvature(i) = (dot(k, n) < 0 ? -0.5 : 0.5) * norm(k);
+        mean_curvature(i) = (dot(k, nn) < 0 ? -0.5 : 0.5) * norm(k);
       });
 }
 
+// Needs compute_node_curvature() first (node H and the corners' mixed areas).
 template <class ExecutionSpace, class MemorySpace>
 void compute_triangle_curvature(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                                 const GeometryBuffers<MemorySpace>& geo, double h_min) {
-  const auto x = mesh.x;
   const auto tri = mesh.tri;
   const auto node_h = geo.node_mean_curvature;
+  const auto corner_area = geo.tri_corner_area;
   const auto tri_h = geo.tri_mean_curvature;
   Kokkos::parallel_for(
       "dcm::curvature::triangles", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_tris),
       KOKKOS_LAMBDA(const int t) {
         double weighted = 0, weight = 0;
         for (int c = 0; c < 3; ++c) {
-          const int i = tri(t, c);
-          const double w = mixed_area_share(load3(x, i), load3(x, tri(t, (c + 1) % 3)),
-                                            load3(x, tri(t, (c + 2) % 3)));
-          weighted += w * node_h(i);
-          weight += w;
+          weighted += corner_area(t, c) * node_h(tri(t, c));
+          weight += corner_area(t, c);
         }
         const double h = weight > 0 ? weighted / weight : 0.0;
-        tri_h(t) = math::max(h, h_min);
+        tri_h(t) = math::max(h, h_min);  // clamp: H_t >= H_min
       });
 }
 

@@ -310,7 +310,10 @@ TEST(SceneParse, RangesAndChoices) {
   EXPECT_TRUE(contains(string_error("[cortex]\nx_max = 1\n"),
                        "cortex.x_max = 1 is out of range: allowed > 1 and ≤ 10"));
   EXPECT_NO_THROW(Scene::from_string("[cortex]\nnu = 0.5\n", "t.toml"));           // inclusive max
-  EXPECT_NO_THROW(Scene::from_string("[geometry]\nh_min_per_m = 0\n", "t.toml"));  // inclusive min
+  EXPECT_NO_THROW(Scene::from_string("[cortex]\nc_N_s_per_m = 0\n", "t.toml"));  // inclusive min
+  // H_min = 0 would make flat triangles' rounded spheres infinite: the clamp must be positive.
+  EXPECT_TRUE(contains(string_error("[geometry]\nh_min_per_m = 0\n"),
+                       "geometry.h_min_per_m = 0 is out of range: allowed > 0"));
   EXPECT_TRUE(contains(string_error("[mesh]\nshape = \"cube\"\n"),
                        "mesh.shape = \"cube\" is not allowed: choose one of sphere, evans_fung"));
   EXPECT_TRUE(
