@@ -20,13 +20,13 @@ struct MeshBuffers {
 
   int n_nodes = 0, n_tris = 0, n_bonds = 0, n_hinges = 0, n_cells = 0;
 
-  View<double* [3]> x;      // node positions (m)
+  View<double* [3]> x;  // node positions (m)
   View<int*> node_cell;
-  View<int* [3]> tri;       // outward oriented
+  View<int* [3]> tri;  // outward oriented
   View<int*> tri_cell;
-  View<int* [2]> bond;      // i < j
+  View<int* [2]> bond;  // i < j
   View<int*> bond_cell;
-  View<int* [4]> hinge;     // (i, j, k, l): triangles (i, j, k) and (j, i, l)
+  View<int* [4]> hinge;  // (i, j, k, l): triangles (i, j, k) and (j, i, l)
   View<int*> hinge_cell;
   View<int*> cell_node_begin, cell_tri_begin, cell_bond_begin, cell_hinge_begin;  // n_cells + 1
   std::vector<int> host_cell_node_begin, host_cell_tri_begin;  // the same ranges, for host-side launches
@@ -34,7 +34,7 @@ struct MeshBuffers {
   // CSR node adjacency (gather kernels need no atomics).
   View<int*> node_tri_offsets, node_tri_corners;  // corner entries packed as 3 * triangle + corner
   View<int*> node_bond_offsets, node_bonds;
-  View<int*> ring_offsets, ring;                  // one-ring neighbours, counter-clockwise from outside
+  View<int*> ring_offsets, ring;  // one-ring neighbours, counter-clockwise from outside
 };
 
 // One cell before upload: its surface and the topology derived from it.

@@ -108,7 +108,8 @@ MeshBuffers<MemorySpace> upload_cells(const std::vector<HostCell>& cells) {
     ent_view = vec_view(name, ent);
   };
   csr(
-      "node_tri_corners", [](const HostCell& c) -> const std::vector<int>& { return c.topology.node_tri_offsets; },
+      "node_tri_corners",
+      [](const HostCell& c) -> const std::vector<int>& { return c.topology.node_tri_offsets; },
       [](const HostCell& c) -> const std::vector<int>& { return c.topology.node_tri_corners; },
       [&](int c, int v) { return v + 3 * tb[c]; }, b.node_tri_offsets, b.node_tri_corners);
   csr(

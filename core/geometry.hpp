@@ -10,17 +10,17 @@ struct GeometryBuffers {
   template <class T>
   using View = Kokkos::View<T, Kokkos::LayoutRight, MemorySpace>;
 
-  View<double*> tri_area;             // A_t (m^2)
-  View<double* [3]> tri_normal;       // unit outward normal n_t
-  View<double* [3]> tri_cot;          // cotangent of the angle at each corner
-  View<double*> cell_area;            // A per cell (m^2)
-  View<double*> cell_volume;          // V per cell (m^3)
-  View<double* [3]> node_curvature;   // K_i, cotangent Laplace-Beltrami mean-curvature vector (1/m)
-  View<double*> node_area;            // mixed Voronoi area A_mixed,i (m^2)
-  View<double* [3]> tri_corner_area;  // each corner's share of A_mixed of its node (m^2)
-  View<double* [3]> node_normal;      // unit area-weighted normal
-  View<double*> node_mean_curvature;  // H_i = sign(K_i . n_i) |K_i| / 2 (1/m)
-  View<double*> tri_mean_curvature;   // H_t, Voronoi-weighted mean of its nodes' H, clamped >= H_min
+  View<double*> tri_area;               // A_t (m^2)
+  View<double* [3]> tri_normal;         // unit outward normal n_t
+  View<double* [3]> tri_cot;            // cotangent of the angle at each corner
+  View<double*> cell_area;              // A per cell (m^2)
+  View<double*> cell_volume;            // V per cell (m^3)
+  View<double* [3]> node_curvature;     // K_i, cotangent Laplace-Beltrami mean-curvature vector (1/m)
+  View<double*> node_area;              // mixed Voronoi area A_mixed,i (m^2)
+  View<double* [3]> tri_corner_area;    // each corner's share of A_mixed of its node (m^2)
+  View<double* [3]> node_normal;        // unit area-weighted normal
+  View<double*> node_mean_curvature;    // H_i = sign(K_i . n_i) |K_i| / 2 (1/m)
+  View<double*> tri_mean_curvature;     // H_t, Voronoi-weighted mean of its nodes' H, clamped >= H_min
   View<double* [3]> tri_sphere_center;  // encompassing ("rounded triangle") sphere centre (m)
   View<double*> tri_sphere_radius;      // its radius R_t = max(1/H_t, circumradius) (m)
 

@@ -27,7 +27,7 @@ struct IoError : std::runtime_error {
 
 struct NodeField {
   std::string name;
-  int components;  // 1 or 3
+  int components;      // 1 or 3
   const double* data;  // host, n_nodes * components, row major
 };
 
@@ -40,7 +40,7 @@ class H5Output {
   H5Output& operator=(const H5Output&) = delete;
 
   void write_text(const std::string& name, const std::string& text);  // root string attribute
-  void write_scalar(const std::string& name, double value);            // /meta/<name>
+  void write_scalar(const std::string& name, double value);           // /meta/<name>
   void write_mesh(const double* x, int n_nodes, const int* triangles, int n_tris, const int* node_cell);
   // Returns the frame index. Requires write_mesh() first.
   int write_frame(double time, const double* x, const std::vector<NodeField>& fields);

@@ -11,8 +11,8 @@ using Vec3 = std::array<double, 3>;
 using Tri = std::array<int, 3>;
 
 struct HostMesh {
-  std::vector<Vec3> nodes;      // m
-  std::vector<Tri> triangles;   // counter-clockwise seen from outside: normals point outward
+  std::vector<Vec3> nodes;     // m
+  std::vector<Tri> triangles;  // counter-clockwise seen from outside: normals point outward
 };
 
 // Node count of an icosphere with k subdivisions: 10*4^k + 2.

@@ -18,10 +18,18 @@ std::string json_string(const std::string& text) {
   std::string out = "\"";
   for (char c : text) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           char buf[8];
@@ -57,7 +65,8 @@ JsonObject& JsonObject::add(const std::string& key, const std::vector<double>& v
 std::string JsonObject::str() const {
   std::string out = "{\n";
   for (std::size_t i = 0; i < members_.size(); ++i)
-    out += "  " + json_string(members_[i].first) + ": " + members_[i].second + (i + 1 < members_.size() ? ",\n" : "\n");
+    out += "  " + json_string(members_[i].first) + ": " + members_[i].second +
+           (i + 1 < members_.size() ? ",\n" : "\n");
   return out + "}\n";
 }
 

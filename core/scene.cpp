@@ -1,6 +1,8 @@
 // Scene: parsing (toml++), validation against scene_schema(), `--set`, accessors and TOML output.
 #include "core/scene.hpp"
 
+#include <toml++/toml.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -10,8 +12,6 @@
 #include <filesystem>
 #include <sstream>
 #include <utility>
-
-#include <toml++/toml.h>
 
 namespace dcm {
 namespace {
@@ -91,13 +91,27 @@ std::string quoted(const std::string& s) {
   std::string out = "\"";
   for (unsigned char c : s) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\b': out += "\\b"; break;
-      case '\t': out += "\\t"; break;
-      case '\n': out += "\\n"; break;
-      case '\f': out += "\\f"; break;
-      case '\r': out += "\\r"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\b':
+        out += "\\b";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\f':
+        out += "\\f";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
       default:
         if (c < 0x20 || c == 0x7f) {
           char buf[8];
@@ -192,10 +206,14 @@ std::string node_text(const toml::node& node) {
 
 std::string expected_text(const ParamSpec& spec) {
   switch (spec.type) {
-    case ParamType::Int: return "an integer";
-    case ParamType::Real: return spec.unit.empty() ? "a real number" : "a real number (" + spec.unit + ")";
-    case ParamType::Bool: return "true or false";
-    case ParamType::String: return "a string";
+    case ParamType::Int:
+      return "an integer";
+    case ParamType::Real:
+      return spec.unit.empty() ? "a real number" : "a real number (" + spec.unit + ")";
+    case ParamType::Bool:
+      return "true or false";
+    case ParamType::String:
+      return "a string";
   }
   return "?";
 }

@@ -25,15 +25,15 @@ struct SceneError : std::runtime_error {
 enum class ParamType { Int, Real, Bool, String };
 
 struct ParamSpec {
-  std::string key;           // dotted, e.g. "mesh.radius_m"
+  std::string key;  // dotted, e.g. "mesh.radius_m"
   ParamType type;
-  std::string default_value; // as TOML text: "4", "3.25e-6", "true", "sphere"
-  double min = 0, max = 0;   // numeric range, used when has_range
+  std::string default_value;  // as TOML text: "4", "3.25e-6", "true", "sphere"
+  double min = 0, max = 0;    // numeric range, used when has_range
   bool has_range = false;
-  bool min_exclusive = false;  // (min, max] instead of [min, max]
+  bool min_exclusive = false;        // (min, max] instead of [min, max]
   std::vector<std::string> choices;  // allowed strings (String) or values (Int), empty = any
-  std::string unit;          // "m", "N/m", "" for dimensionless
-  std::string doc;           // one line
+  std::string unit;                  // "m", "N/m", "" for dimensionless
+  std::string doc;                   // one line
 };
 
 const std::vector<ParamSpec>& scene_schema();

@@ -120,10 +120,14 @@ std::vector<ParamSpec> make_schema() {
 
 const char* type_name(ParamType t) {
   switch (t) {
-    case ParamType::Int: return "integer";
-    case ParamType::Real: return "real";
-    case ParamType::Bool: return "bool";
-    case ParamType::String: return "string";
+    case ParamType::Int:
+      return "integer";
+    case ParamType::Real:
+      return "real";
+    case ParamType::Bool:
+      return "bool";
+    case ParamType::String:
+      return "string";
   }
   return "?";
 }

@@ -45,7 +45,7 @@ void compute_triangle_geometry(const ExecutionSpace& space, const MeshBuffers<Me
         const bool obtuse = d[0] < 0 || d[1] < 0 || d[2] < 0;
         for (int k = 0; k < 3; ++k) {
           const int n = (k + 1) % 3, v = (k + 2) % 3;  // next and previous corner
-          corner_area(t, k) = !obtuse ? 0.125 * (norm2(e[n]) * d[n] * inv + norm2(e[v]) * d[v] * inv)
+          corner_area(t, k) = !obtuse    ? 0.125 * (norm2(e[n]) * d[n] * inv + norm2(e[v]) * d[v] * inv)
                               : d[k] < 0 ? 0.25 * twice_area
                                          : 0.125 * twice_area;
         }

@@ -31,9 +31,9 @@ void run(benchmark::State& state, Kernel&& kernel) {
     space.fence();
   }
   state.counters["nodes"] = f.mesh.n_nodes;
-  state.counters["ns_per_node"] = benchmark::Counter(
-      static_cast<double>(state.iterations()) * f.mesh.n_nodes * 1e-9,
-      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["ns_per_node"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * f.mesh.n_nodes * 1e-9,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
 void update_all(benchmark::State& s) {

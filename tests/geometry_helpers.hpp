@@ -9,8 +9,8 @@
 namespace dcm::test {
 
 struct HostGeometry {
-  std::vector<double> x, tri_area, tri_normal, cell_area, cell_volume, node_curvature, node_area,
-      node_normal, node_mean_curvature, tri_mean_curvature, tri_sphere_center, tri_sphere_radius;
+  std::vector<double> x, tri_area, tri_normal, cell_area, cell_volume, node_curvature, node_area, node_normal,
+      node_mean_curvature, tri_mean_curvature, tri_sphere_center, tri_sphere_radius;
   std::vector<int> tri;
 };
 

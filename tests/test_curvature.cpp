@@ -90,8 +90,8 @@ TEST(EvansFungCurvature, DimpleIsConcave) {
   for (std::size_t i = 0; i < m.nodes.size(); ++i) {
     if (std::hypot(m.nodes[i][0], m.nodes[i][1]) > 1e-15) continue;
     ++poles;
-    std::printf("  Evans-Fung pole node %zu: H = %.4f /um (analytic %.4f)\n", i, g.node_mean_curvature[i] * 1e-6,
-                expected * 1e-6);
+    std::printf("  Evans-Fung pole node %zu: H = %.4f /um (analytic %.4f)\n", i,
+                g.node_mean_curvature[i] * 1e-6, expected * 1e-6);
     EXPECT_NEAR(g.node_mean_curvature[i], expected, 0.03 * std::fabs(expected));
   }
   EXPECT_EQ(poles, 2);

@@ -25,9 +25,10 @@ TEST(SphereMeasures, ConvergeAtSecondOrder) {
     EXPECT_GT(ea, 0);  // inscribed polyhedron: always smaller
     EXPECT_GT(ev, 0);
     // Halving the edge length (one subdivision) divides the error by ~4: second order.
-    const double oa = k > 1 ? std::log2(prev_area_err / ea) : 0, ov = k > 1 ? std::log2(prev_volume_err / ev) : 0;
-    std::printf("  %2d  %6lld   %.3e        %5.2f   %.3e          %5.2f\n", k, icosphere_node_count(k), ea, oa,
-                ev, ov);
+    const double oa = k > 1 ? std::log2(prev_area_err / ea) : 0,
+                 ov = k > 1 ? std::log2(prev_volume_err / ev) : 0;
+    std::printf("  %2d  %6lld   %.3e        %5.2f   %.3e          %5.2f\n", k, icosphere_node_count(k), ea,
+                oa, ev, ov);
     if (k >= 3) {
       EXPECT_NEAR(oa, 2.0, 0.1) << "k = " << k;
       EXPECT_NEAR(ov, 2.0, 0.1) << "k = " << k;

@@ -55,10 +55,18 @@ void expect_same_values(const Scene& a, const Scene& b) {
   EXPECT_EQ(a.name(), b.name());
   for (const ParamSpec& spec : scene_schema()) {
     switch (spec.type) {
-      case ParamType::Int: EXPECT_EQ(a.get_int(spec.key), b.get_int(spec.key)) << spec.key; break;
-      case ParamType::Real: EXPECT_EQ(a.get_real(spec.key), b.get_real(spec.key)) << spec.key; break;
-      case ParamType::Bool: EXPECT_EQ(a.get_bool(spec.key), b.get_bool(spec.key)) << spec.key; break;
-      case ParamType::String: EXPECT_EQ(a.get_string(spec.key), b.get_string(spec.key)) << spec.key; break;
+      case ParamType::Int:
+        EXPECT_EQ(a.get_int(spec.key), b.get_int(spec.key)) << spec.key;
+        break;
+      case ParamType::Real:
+        EXPECT_EQ(a.get_real(spec.key), b.get_real(spec.key)) << spec.key;
+        break;
+      case ParamType::Bool:
+        EXPECT_EQ(a.get_bool(spec.key), b.get_bool(spec.key)) << spec.key;
+        break;
+      case ParamType::String:
+        EXPECT_EQ(a.get_string(spec.key), b.get_string(spec.key)) << spec.key;
+        break;
     }
   }
 }
@@ -90,11 +98,15 @@ TEST(SceneDefaults, EqualTheSchema) {
   for (const ParamSpec& spec : scene_schema()) {
     EXPECT_FALSE(s.was_set(spec.key)) << spec.key;
     switch (spec.type) {
-      case ParamType::Int: EXPECT_EQ(s.get_int(spec.key), std::stoll(spec.default_value)) << spec.key; break;
+      case ParamType::Int:
+        EXPECT_EQ(s.get_int(spec.key), std::stoll(spec.default_value)) << spec.key;
+        break;
       case ParamType::Real:
         EXPECT_EQ(s.get_real(spec.key), std::strtod(spec.default_value.c_str(), nullptr)) << spec.key;
         break;
-      case ParamType::Bool: EXPECT_EQ(s.get_bool(spec.key), spec.default_value == "true") << spec.key; break;
+      case ParamType::Bool:
+        EXPECT_EQ(s.get_bool(spec.key), spec.default_value == "true") << spec.key;
+        break;
       case ParamType::String:
         if (spec.key != "name") {
           EXPECT_EQ(s.get_string(spec.key), spec.default_value) << spec.key;
@@ -309,7 +321,7 @@ TEST(SceneParse, RangesAndChoices) {
                        "cortex.E_Pa = 0 is out of range: allowed > 0 and ≤ 1000000000"));
   EXPECT_TRUE(contains(string_error("[cortex]\nx_max = 1\n"),
                        "cortex.x_max = 1 is out of range: allowed > 1 and ≤ 10"));
-  EXPECT_NO_THROW(Scene::from_string("[cortex]\nnu = 0.5\n", "t.toml"));           // inclusive max
+  EXPECT_NO_THROW(Scene::from_string("[cortex]\nnu = 0.5\n", "t.toml"));         // inclusive max
   EXPECT_NO_THROW(Scene::from_string("[cortex]\nc_N_s_per_m = 0\n", "t.toml"));  // inclusive min
   // H_min = 0 would make flat triangles' rounded spheres infinite: the clamp must be positive.
   EXPECT_TRUE(contains(string_error("[geometry]\nh_min_per_m = 0\n"),

@@ -15,7 +15,8 @@ void add_common_options(CLI::App& app, AppOptions& o) {
                  "Override a scene key, e.g. --set mesh.nodes=642 --set mesh.shape=evans_fung (repeatable; "
                  "--list-keys shows every key)")
       ->type_name("KEY=VALUE");
-  app.add_option("--out", o.out_dir, "Output folder (default: the scene's output.dir, else out/<scene name>)");
+  app.add_option("--out", o.out_dir,
+                 "Output folder (default: the scene's output.dir, else out/<scene name>)");
   app.add_option("--threads", o.threads, "Host threads (default: OMP_NUM_THREADS, else all cores)")
       ->check(CLI::Range(0, 4096));
   app.add_flag("--quiet", o.quiet, "Print only errors");

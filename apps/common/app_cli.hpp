@@ -15,10 +15,10 @@
 namespace dcm {
 
 struct AppOptions {
-  std::string scene_path;          // empty: the built-in defaults
-  std::vector<std::string> sets;   // key=value overrides, applied in order after the file
-  std::string out_dir;             // empty: output.dir, else out/<name>
-  int threads = 0;                 // 0: OMP_NUM_THREADS or all cores
+  std::string scene_path;         // empty: the built-in defaults
+  std::vector<std::string> sets;  // key=value overrides, applied in order after the file
+  std::string out_dir;            // empty: output.dir, else out/<name>
+  int threads = 0;                // 0: OMP_NUM_THREADS or all cores
   bool quiet = false;
 };
 

@@ -89,7 +89,8 @@ void run(const AppOptions& options) {
   for (const auto& e : topo.edges) {
     const double* a = &x[3 * e[0]];
     const double* b = &x[3 * e[1]];
-    edge.add(std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2])));
+    edge.add(std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                       (a[2] - b[2]) * (a[2] - b[2])));
   }
   const double reduced_volume = 6 * std::sqrt(kPi) * volume / std::pow(area, 1.5);
   const std::string shape = scene.get_string("mesh.shape");
@@ -99,10 +100,12 @@ void run(const AppOptions& options) {
     std::printf("dcm geometry: scene '%s' (%s)\n", scene.name().c_str(), scene.origin().c_str());
     std::printf("  %s\n", kokkos_description().c_str());
     std::printf("  mesh         %s, %lld nodes (%lld subdivisions), %zu bonds, %zu triangles, %zu hinges\n",
-                shape.c_str(), nodes, scene.get_int("mesh.subdivisions"), topo.edges.size(), hm.triangles.size(),
-                topo.hinges.size());
-    std::printf("  topology     Euler characteristic %d, closed, consistently oriented\n", topo.euler_characteristic);
-    std::printf("  edge length  min %.4g  mean %.4g  max %.4g um\n", edge.min * 1e6, edge.mean() * 1e6, edge.max * 1e6);
+                shape.c_str(), nodes, scene.get_int("mesh.subdivisions"), topo.edges.size(),
+                hm.triangles.size(), topo.hinges.size());
+    std::printf("  topology     Euler characteristic %d, closed, consistently oriented\n",
+                topo.euler_characteristic);
+    std::printf("  edge length  min %.4g  mean %.4g  max %.4g um\n", edge.min * 1e6, edge.mean() * 1e6,
+                edge.max * 1e6);
     std::printf("  area         %.6g um^2", area * 1e12);
     if (shape == "sphere") {
       const double rad = scene.get_real("mesh.radius_m");
@@ -116,11 +119,14 @@ void run(const AppOptions& options) {
                   100 * (volume * 1e18 / 94.10 - 1));
     }
     std::printf("  reduced vol. %.4f  (6 sqrt(pi) V / A^1.5; 1 for a sphere)\n", reduced_volume);
-    std::printf("  node H       min %.4g  mean %.4g  max %.4g 1/um\n", h.min * 1e-6, h.mean() * 1e-6, h.max * 1e-6);
-    std::printf("  rounded tri. radius min %.4g  mean %.4g  max %.4g um; %lld of %zu clamped at H_min = %g 1/m\n",
-                r.min * 1e6, r.mean() * 1e6, r.max * 1e6, clamped, tri_r.size(), h_min);
-    std::printf("  timing       mesh %.3g ms, upload %.3g ms, geometry kernels %.3g us per update (%.3g ns/node)\n",
-                t_generate * 1e3, t_upload * 1e3, t_geometry * 1e6, t_geometry * 1e9 / nodes);
+    std::printf("  node H       min %.4g  mean %.4g  max %.4g 1/um\n", h.min * 1e-6, h.mean() * 1e-6,
+                h.max * 1e-6);
+    std::printf(
+        "  rounded tri. radius min %.4g  mean %.4g  max %.4g um; %lld of %zu clamped at H_min = %g 1/m\n",
+        r.min * 1e6, r.mean() * 1e6, r.max * 1e6, clamped, tri_r.size(), h_min);
+    std::printf(
+        "  timing       mesh %.3g ms, upload %.3g ms, geometry kernels %.3g us per update (%.3g ns/node)\n",
+        t_generate * 1e3, t_upload * 1e3, t_geometry * 1e6, t_geometry * 1e9 / nodes);
   }
 
   JsonObject summary;
@@ -158,17 +164,19 @@ void run(const AppOptions& options) {
     h5.close();
   }
   if (!options.quiet)
-    std::printf("  wrote        %s/geometry.json%s\n", out.c_str(),
-                scene.get_bool("output.hdf5") ? (", " + out + "/geometry.h5, " + out + "/geometry.xmf").c_str() : "");
+    std::printf(
+        "  wrote        %s/geometry.json%s\n", out.c_str(),
+        scene.get_bool("output.hdf5") ? (", " + out + "/geometry.h5, " + out + "/geometry.xmf").c_str() : "");
 }
 
 }  // namespace
 }  // namespace dcm
 
 int main(int argc, char** argv) {
-  CLI::App app("Builds the scene's cell mesh and reports its geometry: area, volume, curvature, rounded\n"
-               "triangles. Writes <out>/geometry.json, and <out>/geometry.h5 with geometry.xmf (ParaView).",
-               "geometry");
+  CLI::App app(
+      "Builds the scene's cell mesh and reports its geometry: area, volume, curvature, rounded\n"
+      "triangles. Writes <out>/geometry.json, and <out>/geometry.h5 with geometry.xmf (ParaView).",
+      "geometry");
   dcm::AppOptions options;
   dcm::add_common_options(app, options);
   return dcm::run_app(app, argc, argv, [&] { dcm::run(options); });
