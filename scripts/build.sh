@@ -12,8 +12,10 @@ case "$preset" in
   debug) builddir=build-debug ;;
   *) echo "scripts/build.sh: unknown preset '$preset' (release, debug)" >&2; exit 2 ;;
 esac
-if [ ! -f "$builddir/CMakeCache.txt" ] || ! grep -q "^DCM_PRESET:.*=$preset$" "$builddir/CMakeCache.txt"; then
-  cmake --preset "$preset" -DKokkos_ROOT="$kokkos" -DDCM_PRESET="$preset" >&2
+# Configure when there is no build yet, or the preset, the Kokkos or CI-ness (warnings as errors) changed.
+stamp="$preset;$kokkos;ci=${CI:-false}"
+if [ ! -f "$builddir/CMakeCache.txt" ] || ! grep -qxF "DCM_CONFIGURED_FOR:STRING=$stamp" "$builddir/CMakeCache.txt"; then
+  cmake --preset "$preset" -DKokkos_ROOT="$kokkos" "-DDCM_CONFIGURED_FOR:STRING=$stamp" >&2
 fi
 targets=()
 for t in "$@"; do targets+=(--target "$t"); done

@@ -9,6 +9,16 @@
 namespace dcm {
 
 void add_common_options(CLI::App& app, AppOptions& o) {
+  app.footer(
+      "Examples:\n"
+      "  " +
+      app.get_name() +
+      " scenes/default.toml\n"
+      "  " +
+      app.get_name() +
+      " scenes/evans_fung.toml --set mesh.nodes=10242 --out out/ef10k\n"
+      "Exit codes: 0 success, 2 bad input (nothing written), 3 numerical failure, 1 internal error.\n"
+      "Scene keys: --list-keys or docs/SCENES.md.");
   app.add_option("scene", o.scene_path, "Scene file (TOML); without one the built-in defaults run")
       ->check(CLI::ExistingFile);
   app.add_option("--set", o.sets,
@@ -56,11 +66,8 @@ int run_app(CLI::App& app, int argc, char** argv, const std::function<void()>& b
   const std::string name = app.get_name();
   try {
     app.parse(argc, argv);
-  } catch (const CLI::Success&) {
-    return 0;
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
   } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help (prints it), --list-keys (printed already)
     std::cerr << name << ": error: " << e.what() << " (see --help)\n";
     return 2;
   }
