@@ -1,0 +1,187 @@
+// The friction operator Γ and the preconditioned CG solve of Γ v = F.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "core/host_copy.hpp"
+#include "solvers/friction_operator.hpp"
+#include "solvers/pcg.hpp"
+
+namespace dcm {
+namespace {
+
+using Exec = Kokkos::DefaultExecutionSpace;
+using Mem = Exec::memory_space;
+using Vector = FrictionOperator<Mem>::Vector;
+constexpr double kPi = 3.14159265358979323846;
+
+// Table 1: η = 0.8 mPa·s, r = 3.25 µm, c = 1.5e-6 N·s/m.
+struct FrictionSetup {
+  MeshBuffers<Mem> mesh;
+  FrictionOperator<Mem> op;
+  explicit FrictionSetup(int k, double c = 1.5e-6, unsigned seed = 7) {
+    HostMesh m = make_icosphere(k, 3.25e-6);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-0.05e-6, 0.05e-6);
+    for (auto& x : m.nodes)
+      for (double& v : x) v += u(rng);
+    mesh = upload_cells<Mem>({HostCell(m)});
+    Kokkos::View<double*, Kokkos::LayoutRight, Mem> drag("drag", mesh.n_nodes);
+    Kokkos::deep_copy(drag, 6 * kPi * 0.8e-3 * 3.25e-6 / mesh.n_nodes);
+    op = FrictionOperator<Mem>(mesh, drag, c);
+    update_friction(Exec(), mesh, op);
+  }
+  Vector random_vector(unsigned seed, double scale = 1.0) const {
+    Vector v("v", mesh.n_nodes);
+    auto h = Kokkos::create_mirror_view(v);
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> g(0, scale);
+    for (int i = 0; i < mesh.n_nodes; ++i)
+      for (int d = 0; d < 3; ++d) h(i, d) = g(rng);
+    Kokkos::deep_copy(v, h);
+    return v;
+  }
+  Vector apply(const Vector& v) const {
+    Vector out("out", mesh.n_nodes);
+    apply_friction(Exec(), mesh, op, v, out);
+    return out;
+  }
+  // Γ assembled on the host from its definition (independent of the kernels): drag on the diagonal,
+  // c n̂n̂ᵀ blocks coupling the two nodes of every bond.
+  Eigen::MatrixXd assemble() const {
+    const int n = mesh.n_nodes;
+    const auto x = to_host_vector(mesh.x);
+    const auto bonds = to_host_vector(mesh.bond);
+    const auto drag = to_host_vector(op.node_drag);
+    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+    for (int i = 0; i < n; ++i) a.block<3, 3>(3 * i, 3 * i) += drag[i] * Eigen::Matrix3d::Identity();
+    for (std::size_t b = 0; b < bonds.size() / 2; ++b) {
+      const int i = bonds[2 * b], j = bonds[2 * b + 1];
+      const Eigen::Vector3d d = Eigen::Vector3d(x[3 * j], x[3 * j + 1], x[3 * j + 2]) -
+                                Eigen::Vector3d(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
+      const Eigen::Matrix3d nn = op.dashpot * d.normalized() * d.normalized().transpose();
+      a.block<3, 3>(3 * i, 3 * i) += nn;
+      a.block<3, 3>(3 * j, 3 * j) += nn;
+      a.block<3, 3>(3 * i, 3 * j) -= nn;
+      a.block<3, 3>(3 * j, 3 * i) -= nn;
+    }
+    return a;
+  }
+};
+
+double dot_host(const std::vector<double>& a, const std::vector<double>& b) {
+  double s = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) s += a[i] * b[i];
+  return s;
+}
+
+TEST(FrictionOperator, SymmetricAndPositiveOnRandomVectors) {
+  const FrictionSetup s(3);
+  for (unsigned seed = 1; seed <= 5; ++seed) {
+    const Vector u = s.random_vector(seed), w = s.random_vector(seed + 100);
+    const auto gu = to_host_vector(s.apply(u)), gw = to_host_vector(s.apply(w));
+    const auto hu = to_host_vector(u), hw = to_host_vector(w);
+    const double uGw = dot_host(hu, gw), wGu = dot_host(hw, gu);
+    EXPECT_NEAR(uGw, wGu, 1e-12 * std::fabs(uGw) + 1e-30);
+    EXPECT_GT(dot_host(hu, gu), 0.0);
+  }
+}
+
+TEST(FrictionOperator, RigidTranslationFeelsOnlyTheDrag) {
+  const FrictionSetup s(3);
+  Vector v("v", s.mesh.n_nodes);
+  Kokkos::deep_copy(Kokkos::subview(v, Kokkos::ALL(), 0), 2.0);  // every node moves at 2 m/s along x
+  const auto g = to_host_vector(s.apply(v));
+  const double zeta = 6 * kPi * 0.8e-3 * 3.25e-6 / s.mesh.n_nodes;
+  for (int i = 0; i < s.mesh.n_nodes; ++i) {
+    EXPECT_NEAR(g[3 * i], 2 * zeta, 1e-9 * zeta);
+    EXPECT_NEAR(g[3 * i + 1], 0, 1e-9 * zeta);
+  }
+}
+
+TEST(FrictionOperator, MatchesTheAssembledMatrixWhichIsPositiveDefinite) {
+  const FrictionSetup s(2);
+  const Eigen::MatrixXd a = s.assemble();
+  const Vector v = s.random_vector(21);
+  const auto vh = to_host_vector(v), gv = to_host_vector(s.apply(v));
+  const Eigen::VectorXd expected = a * Eigen::Map<const Eigen::VectorXd>(vh.data(), vh.size());
+  EXPECT_LT((Eigen::Map<const Eigen::VectorXd>(gv.data(), gv.size()) - expected).norm(),
+            1e-12 * expected.norm());
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a, Eigen::EigenvaluesOnly);
+  const double lo = eig.eigenvalues().minCoeff(), hi = eig.eigenvalues().maxCoeff();
+  std::printf("  162 nodes, paper parameters: eigenvalues of Gamma in [%.3g, %.3g] N s/m, kappa = %.3g\n", lo,
+              hi, hi / lo);
+  EXPECT_GT(lo, 0.0);
+}
+
+TEST(Pcg, AgreesWithEigenReferenceOn642Nodes) {
+  const FrictionSetup s(3);  // 642 nodes, paper parameters
+  const Eigen::MatrixXd a = s.assemble();
+  const Vector f = s.random_vector(11, 1e-12);  // pN-scale forces
+  const auto fh = to_host_vector(f);
+  const Eigen::VectorXd reference = a.llt().solve(Eigen::Map<const Eigen::VectorXd>(fh.data(), fh.size()));
+
+  Vector v("v", s.mesh.n_nodes);  // cold start
+  CgWorkspace<Mem> w(s.mesh.n_nodes);
+  CgSettings settings;
+  settings.abs_tol = 0;
+  settings.rel_tol = 1e-12;
+  const Exec space;
+  const CgResult r = pcg_solve(
+      space, [&](const Vector& in, const Vector& out) { apply_friction(space, s.mesh, s.op, in, out); },
+      [&](const Vector& in, const Vector& out) { apply_block_jacobi(space, s.op, in, out); }, f, v, w,
+      settings);
+  std::printf("  642 nodes: block-Jacobi PCG, cold start, %d iterations to 1e-12 relative\n", r.iterations);
+  ASSERT_TRUE(r.converged);
+  const auto vh = to_host_vector(v);
+  const Eigen::VectorXd diff = Eigen::Map<const Eigen::VectorXd>(vh.data(), vh.size()) - reference;
+  EXPECT_LT(diff.norm(), 1e-8 * reference.norm());
+
+  // Warm start from the solution: converged at once (round-off may ask for an iteration or two).
+  const CgResult again = pcg_solve(
+      space, [&](const Vector& in, const Vector& out) { apply_friction(space, s.mesh, s.op, in, out); },
+      [&](const Vector& in, const Vector& out) { apply_block_jacobi(space, s.op, in, out); }, f, v, w,
+      settings);
+  EXPECT_LE(again.iterations, 2);
+}
+
+TEST(Pcg, ReportsNonConvergence) {
+  const FrictionSetup s(3);
+  const Vector f = s.random_vector(3, 1e-12);
+  Vector v("v", s.mesh.n_nodes);
+  CgWorkspace<Mem> w(s.mesh.n_nodes);
+  CgSettings settings;
+  settings.abs_tol = 0;
+  settings.rel_tol = 1e-14;
+  settings.max_iterations = 3;
+  const Exec space;
+  const CgResult r = pcg_solve(
+      space, [&](const Vector& in, const Vector& out) { apply_friction(space, s.mesh, s.op, in, out); },
+      [&](const Vector& in, const Vector& out) { apply_block_jacobi(space, s.op, in, out); }, f, v, w,
+      settings);
+  EXPECT_FALSE(r.converged);
+  EXPECT_EQ(r.iterations, 3);
+}
+
+TEST(Pcg, DiagonalSystemWithoutDashpotsIsOneStep) {
+  const FrictionSetup s(3, /*c=*/0.0);
+  const Vector f = s.random_vector(5, 1e-12);
+  Vector v("v", s.mesh.n_nodes);
+  CgWorkspace<Mem> w(s.mesh.n_nodes);
+  CgSettings settings;
+  settings.abs_tol = 0;
+  settings.rel_tol = 1e-13;
+  const Exec space;
+  const CgResult r = pcg_solve(
+      space, [&](const Vector& in, const Vector& out) { apply_friction(space, s.mesh, s.op, in, out); },
+      [&](const Vector& in, const Vector& out) { apply_block_jacobi(space, s.op, in, out); }, f, v, w,
+      settings);
+  EXPECT_TRUE(r.converged);
+  EXPECT_LE(r.iterations, 1);
+}
+
+}  // namespace
+}  // namespace dcm
