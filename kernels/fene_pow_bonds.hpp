@@ -82,7 +82,8 @@ void add_fene_pow_forces(const ExecutionSpace& space, const MeshBuffers<MemorySp
   const auto offsets = mesh.node_bond_offsets;
   const auto bonds = mesh.node_bonds;
   const auto rest_length = rest.rest_length;
-  const double k_s = params.k_s, x_max = params.x_max;
+  const double k_s = params.k_s, x_max2 = params.x_max * params.x_max;
+  const double k_c_factor = k_s / (1 - 1 / x_max2);  // k_c = k_c_factor d*^3, eq. 24
   Kokkos::parallel_for(
       "dcm::bonds::fene_pow", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
@@ -92,12 +93,15 @@ void add_fene_pow_forces(const ExecutionSpace& space, const MeshBuffers<MemorySp
           const int b = bonds(s);
           const int j = bond(b, 0) == i ? bond(b, 1) : bond(b, 0);
           const Real3 r = p - load3(x, j);
-          const double d = norm(r), d_rest = rest_length(b);
-          if (!fene_pow_bond_ok(d, d_rest, x_max)) {
+          const double d2 = norm2(r), d_rest = rest_length(b), d_max2 = x_max2 * d_rest * d_rest;
+          if (!(math::isfinite(d2) && d2 > 0 && d2 < d_max2)) {
             Kokkos::atomic_compare_exchange(&overstretched(), -1, b);
             continue;
           }
-          f += (-fene_pow_force_magnitude(d, d_rest, k_s, x_max) / d) * r;
+          // U'(d) / d = k_s d_max^2 / (d_max^2 - d^2) - k_c / d^3 (two divisions, one square root)
+          const double u_over_d =
+              k_s * d_max2 / (d_max2 - d2) - k_c_factor * d_rest * d_rest * d_rest / (d2 * math::sqrt(d2));
+          f += (-u_over_d) * r;
         }
         force(i, 0) += f.x;
         force(i, 1) += f.y;
