@@ -34,7 +34,8 @@ struct MeshBuffers {
   // CSR node adjacency (gather kernels need no atomics).
   View<int*> node_tri_offsets, node_tri_corners;  // corner entries packed as 3 * triangle + corner
   View<int*> node_bond_offsets, node_bonds;
-  View<int*> ring_offsets, ring;  // one-ring neighbours, counter-clockwise from outside
+  View<int*> node_hinge_offsets, node_hinge_roles;  // hinge entries packed as 4 * hinge + role (0..3)
+  View<int*> ring_offsets, ring;                    // one-ring neighbours, counter-clockwise from outside
 };
 
 // One cell before upload: its surface and the topology derived from it.

@@ -93,7 +93,7 @@ MeshBuffers<MemorySpace> upload_cells(const std::vector<HostCell>& cells) {
   });
 
   // CSR arrays: offsets shifted by the cell's first entry, entries shifted by the cell's first
-  // node / triangle / bond.
+  // node / triangle / bond / hinge.
   auto csr = [&](const std::string& name, auto offsets_of, auto entries_of, auto shift_entry,
                  typename B::template View<int*>& off_view, typename B::template View<int*>& ent_view) {
     std::vector<int> off(1, 0), ent;
@@ -116,6 +116,11 @@ MeshBuffers<MemorySpace> upload_cells(const std::vector<HostCell>& cells) {
       "node_bonds", [](const HostCell& c) -> const std::vector<int>& { return c.topology.node_edge_offsets; },
       [](const HostCell& c) -> const std::vector<int>& { return c.topology.node_edges; },
       [&](int c, int v) { return v + bb[c]; }, b.node_bond_offsets, b.node_bonds);
+  csr(
+      "node_hinge_roles",
+      [](const HostCell& c) -> const std::vector<int>& { return c.topology.node_hinge_offsets; },
+      [](const HostCell& c) -> const std::vector<int>& { return c.topology.node_hinge_roles; },
+      [&](int c, int v) { return v + 4 * hb[c]; }, b.node_hinge_offsets, b.node_hinge_roles);
   csr(
       "ring", [](const HostCell& c) -> const std::vector<int>& { return c.topology.ring_offsets; },
       [](const HostCell& c) -> const std::vector<int>& { return c.topology.ring; },

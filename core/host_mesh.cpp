@@ -187,6 +187,17 @@ Topology build_topology(const HostMesh& m) {
   std::fill(fill.begin(), fill.end(), 0);
   for (int e = 0; e < static_cast<int>(t.edges.size()); ++e)
     for (int v : t.edges[e]) t.node_edges[t.node_edge_offsets[v] + fill[v]++] = e;
+  std::vector<int> hinge_count(n, 0);
+  for (const auto& h : t.hinges)
+    for (int v : h) ++hinge_count[v];
+  t.node_hinge_offsets = offsets_from_counts(hinge_count);
+  t.node_hinge_roles.assign(t.node_hinge_offsets[n], 0);
+  std::fill(fill.begin(), fill.end(), 0);
+  for (int h = 0; h < static_cast<int>(t.hinges.size()); ++h)
+    for (int r = 0; r < 4; ++r) {
+      const int v = t.hinges[h][r];
+      t.node_hinge_roles[t.node_hinge_offsets[v] + fill[v]++] = 4 * h + r;
+    }
   for (int v = 0; v < n; ++v)
     if (tri_count[v] < 3)
       throw std::runtime_error("mesh: node " + std::to_string(v) + " belongs to fewer than 3 triangles");

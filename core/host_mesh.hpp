@@ -49,6 +49,8 @@ struct Topology {
   std::vector<int> node_tri_offsets, node_tri_corners;
   // CSR: node -> incident edges.
   std::vector<int> node_edge_offsets, node_edges;
+  // CSR: node -> the hinges it belongs to, packed as 4*hinge + role, role its slot in (i, j, k, l).
+  std::vector<int> node_hinge_offsets, node_hinge_roles;
   // CSR: node -> neighbours in cyclic order, counter-clockwise seen from outside (the one-ring).
   std::vector<int> ring_offsets, ring;
   int euler_characteristic = 0;  // V - E + F

@@ -100,9 +100,15 @@ TEST(Topology, CsrListsAreComplete) {
       const auto& e = t.edges[t.node_edges[s]];
       EXPECT_TRUE(e[0] == i || e[1] == i);
     }
+    // Node i is an edge end of each incident edge and the tip of each incident triangle's far hinge.
+    const int valence = t.node_edge_offsets[i + 1] - t.node_edge_offsets[i];
+    EXPECT_EQ(t.node_hinge_offsets[i + 1] - t.node_hinge_offsets[i], 2 * valence);
+    for (int s = t.node_hinge_offsets[i]; s < t.node_hinge_offsets[i + 1]; ++s)
+      EXPECT_EQ(t.hinges[t.node_hinge_roles[s] / 4][t.node_hinge_roles[s] % 4], i);
   }
   EXPECT_EQ(t.node_tri_offsets.back(), 3 * static_cast<int>(m.triangles.size()));
   EXPECT_EQ(t.node_edge_offsets.back(), 2 * static_cast<int>(t.edges.size()));
+  EXPECT_EQ(t.node_hinge_offsets.back(), 4 * static_cast<int>(t.hinges.size()));
 }
 
 TEST(Topology, RejectsOpenAndMisorientedSurfaces) {

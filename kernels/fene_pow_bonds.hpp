@@ -1,0 +1,132 @@
+#pragma once
+// In-plane elasticity of the cortex: FENE + POW per bond (paper eqs. 21-24, L = 2; MODEL.md section 3).
+//
+// Bond b = (i, j), length d = |x_i - x_j|, rest length d* (the bond's length in the rest shape),
+// d_max = x_max d*. Energy (eq. 21 plus the POW energy whose force magnitude is eq. 23):
+//   U(d)  = -(k_s / 2) d_max^2 ln(1 - d^2 / d_max^2) + k_c / d               (L = 2: k_c / ((L-1) d^(L-1)))
+//   U'(d) =  k_s d / (1 - d^2 / d_max^2) - k_c / d^2                           (N)
+//   k_c   =  k_s d*^3 / (1 - d*^2 / d_max^2) = k_s d*^3 / (1 - 1 / x_max^2)   (eq. 24, N m^2)
+// U'(d*) = 0: every bond is force-free at its rest length. The force on node i is
+//   F_i = -U'(d) (x_i - x_j) / d,   F_j = -F_i,
+// i.e. FENE (|eq. 22|) pulls the nodes together, POW (eq. 23) pushes them apart; U' > 0 (attraction)
+// for d > d*, U' < 0 (repulsion) for d < d*. Units: k_s N/m (Table 1's "J" is a typo), x_max 1.
+//
+// FENE diverges at d -> d_max. A bond with d >= d_max, d <= 0 or d not finite contributes no force and
+// no NaN; instead its index is written into the `overstretched` flag (first one wins) for the host to
+// report. Its energy is +infinity.
+//
+// Expectations (tests/test_bonds_bending.cpp): F = -grad U (central differences), F = 0 at the rest
+// shape, zero net force and torque, U'(d) = |eq. 22| - eq. 23 for a single bond, the flag at
+// 1.0001 d_max, the same result on Serial and OpenMP.
+#include <limits>
+
+#include "core/buffers.hpp"
+#include "core/vec3.hpp"
+
+namespace dcm {
+
+struct FenePowParams {
+  double k_s = 3.2e-6;  // FENE stretching constant (N/m)
+  double x_max = 2.05;  // maximal stretch d_max / d* (1)
+};
+
+// Rest state of the bonds: d* per bond (m).
+template <class MemorySpace>
+struct BondRest {
+  Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> rest_length;
+};
+
+// dU/dd of one bond (N): |F_FENE| - F_POW, eqs. 22-24 with L = 2.
+KOKKOS_INLINE_FUNCTION double fene_pow_force_magnitude(double d, double d_rest, double k_s, double x_max) {
+  const double d_max2 = x_max * x_max * d_rest * d_rest;
+  const double k_c = k_s * d_rest * d_rest * d_rest / (1 - 1 / (x_max * x_max));  // eq. 24
+  return k_s * d / (1 - d * d / d_max2) - k_c / (d * d);
+}
+
+// U of one bond (J), eq. 21 + k_c / d; only for 0 < d < d_max.
+KOKKOS_INLINE_FUNCTION double fene_pow_bond_energy(double d, double d_rest, double k_s, double x_max) {
+  const double d_max2 = x_max * x_max * d_rest * d_rest;
+  const double k_c = k_s * d_rest * d_rest * d_rest / (1 - 1 / (x_max * x_max));
+  return -0.5 * k_s * d_max2 * math::log(1 - d * d / d_max2) + k_c / d;
+}
+
+// Whether a bond of length d can be evaluated: 0 < d < d_max and finite.
+KOKKOS_INLINE_FUNCTION bool fene_pow_bond_ok(double d, double d_rest, double x_max) {
+  return math::isfinite(d) && d > 0 && d < x_max * d_rest;
+}
+
+// d* of every bond from the current positions.
+template <class ExecutionSpace, class MemorySpace>
+BondRest<MemorySpace> make_bond_rest(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh) {
+  BondRest<MemorySpace> rest;
+  rest.rest_length = decltype(rest.rest_length)(
+      Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::bonds::rest_length"), mesh.n_bonds);
+  const auto x = mesh.x;
+  const auto bond = mesh.bond;
+  const auto length = rest.rest_length;
+  Kokkos::parallel_for(
+      "dcm::bonds::rest_length", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_bonds),
+      KOKKOS_LAMBDA(const int b) { length(b) = norm(load3(x, bond(b, 0)) - load3(x, bond(b, 1))); });
+  return rest;
+}
+
+// force(i) += sum over the bonds of node i of F_i (a gather over the node's CSR bond list: no atomics).
+// overstretched: set to -1 by the caller; receives the index of a bond that could not be evaluated.
+template <class ExecutionSpace, class MemorySpace>
+void add_fene_pow_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                         const BondRest<MemorySpace>& rest, const FenePowParams& params,
+                         const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& force,
+                         const Kokkos::View<int, MemorySpace>& overstretched) {
+  const auto x = mesh.x;
+  const auto bond = mesh.bond;
+  const auto offsets = mesh.node_bond_offsets;
+  const auto bonds = mesh.node_bonds;
+  const auto rest_length = rest.rest_length;
+  const double k_s = params.k_s, x_max2 = params.x_max * params.x_max;
+  const double k_c_factor = k_s / (1 - 1 / x_max2);  // k_c = k_c_factor d*^3, eq. 24
+  Kokkos::parallel_for(
+      "dcm::bonds::fene_pow", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
+      KOKKOS_LAMBDA(const int i) {
+        const Real3 p = load3(x, i);
+        Real3 f{0, 0, 0};
+        for (int s = offsets(i); s < offsets(i + 1); ++s) {
+          const int b = bonds(s);
+          const int j = bond(b, 0) == i ? bond(b, 1) : bond(b, 0);
+          const Real3 r = p - load3(x, j);
+          const double d2 = norm2(r), d_rest = rest_length(b), d_max2 = x_max2 * d_rest * d_rest;
+          if (!(math::isfinite(d2) && d2 > 0 && d2 < d_max2)) {
+            Kokkos::atomic_compare_exchange(&overstretched(), -1, b);
+            continue;
+          }
+          // U'(d) / d = k_s d_max^2 / (d_max^2 - d^2) - k_c / d^3 (two divisions, one square root)
+          const double u_over_d =
+              k_s * d_max2 / (d_max2 - d2) - k_c_factor * d_rest * d_rest * d_rest / (d2 * math::sqrt(d2));
+          f += (-u_over_d) * r;
+        }
+        force(i, 0) += f.x;
+        force(i, 1) += f.y;
+        force(i, 2) += f.z;
+      });
+}
+
+// Total FENE + POW energy of all cells (J); +infinity if a bond cannot be evaluated.
+template <class ExecutionSpace, class MemorySpace>
+double fene_pow_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                       const BondRest<MemorySpace>& rest, const FenePowParams& params) {
+  const auto x = mesh.x;
+  const auto bond = mesh.bond;
+  const auto rest_length = rest.rest_length;
+  const double k_s = params.k_s, x_max = params.x_max;
+  const double infinity = std::numeric_limits<double>::infinity();
+  double energy = 0;
+  Kokkos::parallel_reduce(
+      "dcm::bonds::fene_pow_energy", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_bonds),
+      KOKKOS_LAMBDA(const int b, double& sum) {
+        const double d = norm(load3(x, bond(b, 0)) - load3(x, bond(b, 1))), d_rest = rest_length(b);
+        sum += fene_pow_bond_ok(d, d_rest, x_max) ? fene_pow_bond_energy(d, d_rest, k_s, x_max) : infinity;
+      },
+      energy);
+  return energy;
+}
+
+}  // namespace dcm
