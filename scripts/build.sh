@@ -17,6 +17,10 @@ stamp="$preset;$kokkos;ci=${CI:-false}"
 if [ ! -f "$builddir/CMakeCache.txt" ] || ! grep -qxF "DCM_CONFIGURED_FOR:STRING=$stamp" "$builddir/CMakeCache.txt"; then
   cmake --preset "$preset" -DKokkos_ROOT="$kokkos" "-DDCM_CONFIGURED_FOR:STRING=$stamp" >&2
 fi
+# A named target that a changed CMakeLists.txt just added needs the build system regenerated first.
+if [ $# -gt 0 ] && [ -n "$(find . -name CMakeLists.txt -newer "$builddir/CMakeCache.txt" -not -path './build*' | head -n 1)" ]; then
+  cmake -S . -B "$builddir" >&2 && touch "$builddir/CMakeCache.txt"
+fi
 targets=()
 for t in "$@"; do targets+=(--target "$t"); done
 cmake --build "$builddir" --parallel "$(nproc)" "${targets[@]}" >&2

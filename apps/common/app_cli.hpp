@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/errors.hpp"
 #include "core/scene.hpp"
 
 namespace dcm {
@@ -20,11 +21,6 @@ struct AppOptions {
   std::string out_dir;            // empty: output.dir, else out/<name>
   int threads = 0;                // 0: OMP_NUM_THREADS or all cores
   bool quiet = false;
-};
-
-// Thrown for a failure that exits with code 3 (numerical trouble).
-struct NumericalError : std::runtime_error {
-  using std::runtime_error::runtime_error;
 };
 
 void add_common_options(CLI::App& app, AppOptions& options);

@@ -1,0 +1,39 @@
+#pragma once
+// From a scene to the cells and the mechanical constants of a run (shared by the mechanics apps).
+#include <cmath>
+#include <vector>
+
+#include "core/host_mesh.hpp"
+#include "core/scene.hpp"
+#include "solvers/cortex_model.hpp"
+
+namespace dcm {
+
+inline HostMesh cell_mesh_from_scene(const Scene& scene) {
+  const int k = static_cast<int>(scene.get_int("mesh.subdivisions"));
+  if (scene.get_string("mesh.shape") == "evans_fung") {
+    EvansFungShape shape;
+    shape.diameter = scene.get_real("mesh.diameter_m");
+    return make_evans_fung(k, shape);
+  }
+  return make_icosphere(k, scene.get_real("mesh.radius_m"));
+}
+
+// Table 1 constants as the energies of docs/model/ use them (docs/MODEL.md section 3 says why):
+// k_s (N/m), x_max, k_b (J), c (N·s/m) as given; cortex.k_a, cortex.k_d (N/m) and cortex.k_v (Pa) are the
+// constants of E = k (X − X*)² / (2 X*) for the triangle areas, the cell area and the cell volume.
+inline MechanicsParams mechanics_from_scene(const Scene& scene) {
+  MechanicsParams p;
+  p.bonds.k_s = scene.get_real("cortex.k_s_N_per_m");
+  p.bonds.x_max = scene.get_real("cortex.x_max");
+  p.k_b = scene.get_real("cortex.k_b_J");
+  p.k_area_local = scene.get_real("cortex.k_a");
+  p.k_area_global = scene.get_real("cortex.k_d");
+  p.k_volume = scene.get_real("cortex.k_v");
+  p.dashpot = scene.get_real("cortex.c_N_s_per_m");
+  p.viscosity = scene.get_real("fluid.eta_Pa_s");
+  p.h_min = scene.get_real("geometry.h_min_per_m");
+  return p;
+}
+
+}  // namespace dcm

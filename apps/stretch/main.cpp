@@ -1,0 +1,145 @@
+// stretch: the optical-tweezers experiment of the paper (its Figure 2; Mills et al. 2004): the outermost
+// 5% of the nodes at each end of the cell are pulled along x with ±F/n each, the cell is brought to
+// equilibrium, and the axial and transverse diameters D_A, D_T are recorded for every force.
+// Writes <out>/series.csv (F_N,DA_m,DT_m), <out>/summary.json, <out>/stretch.h5 (+ .xmf) with one frame
+// per force, and <out>/stretch.png against ../shared/data/stretching when plotting is available.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <numeric>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "apps/common/app_cli.hpp"
+#include "apps/common/mechanics_setup.hpp"
+#include "core/h5_output.hpp"
+#include "core/host_copy.hpp"
+#include "core/json_writer.hpp"
+#include "core/kokkos_compat.hpp"
+#include "solvers/fire_minimizer.hpp"
+
+namespace dcm {
+namespace {
+
+using Exec = Kokkos::DefaultExecutionSpace;
+
+struct StretchOptions {
+  std::vector<double> forces_pN = {0, 15.987, 19.338, 30.754, 38.365, 47.245, 67.964, 87.837,
+                                   108.949, 130.513, 150.809, 172.374, 192.688, 200};  // Mills 2004 + 200
+  double pulled_fraction = 0.05;
+  bool plot = true;
+};
+
+// Node indices of the outermost `fraction` of nodes at the -x and +x ends.
+std::pair<std::vector<int>, std::vector<int>> pulled_nodes(const HostMesh& m, double fraction) {
+  std::vector<int> order(m.nodes.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return m.nodes[a][0] < m.nodes[b][0]; });
+  const std::size_t n = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(fraction * m.nodes.size())));
+  return {std::vector<int>(order.begin(), order.begin() + n), std::vector<int>(order.end() - n, order.end())};
+}
+
+void run(const AppOptions& options, const StretchOptions& so) {
+  const Scene scene = load_scene(options);
+  for (double f : so.forces_pN)
+    if (!(f >= 0 && f <= 1e4)) throw SceneError("--forces-pN: " + std::to_string(f) + " is out of range: allowed 0 .. 10000");
+  const std::string out = prepare_output_dir(options, scene);
+  KokkosSession kokkos(options.threads);
+  const auto wall0 = std::chrono::steady_clock::now();
+
+  const HostMesh mesh = cell_mesh_from_scene(scene);
+  const auto [left, right] = pulled_nodes(mesh, so.pulled_fraction);
+  MechanicsParams params = mechanics_from_scene(scene);
+  CortexModel<Exec> model(Exec(), {HostCell(mesh)}, params);
+  const int n = model.mesh().n_nodes;
+  double edge = 0;
+  {
+    const Topology& t = build_topology(mesh);
+    for (const auto& e : t.edges) {
+      const auto& a = mesh.nodes[e[0]];
+      const auto& b = mesh.nodes[e[1]];
+      edge += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+    }
+    edge /= t.edges.size();
+  }
+  if (!options.quiet)
+    std::printf("dcm stretch: scene '%s', %s, %d nodes, %zu pulled at each end; %s\n", scene.name().c_str(),
+                scene.get_string("mesh.shape").c_str(), n, left.size(), kokkos_description().c_str());
+
+  std::vector<int> tri, node_cell(n, 0);
+  for (const Tri& t : mesh.triangles) tri.insert(tri.end(), t.begin(), t.end());
+  H5Output h5(out + "/stretch.h5");
+  h5.write_text("scene", scene.to_toml());
+  {
+    const auto x0 = to_host_vector(model.positions());
+    h5.write_mesh(x0.data(), n, tri.data(), static_cast<int>(mesh.triangles.size()), node_cell.data());
+  }
+  std::ofstream csv(out + "/series.csv.tmp");
+  csv << "F_N,DA_m,DT_m,fire_steps,max_residual_force_N\n";
+  std::vector<double> forces, da, dt;
+  auto ext = Kokkos::create_mirror_view(model.external_force());
+  for (double f_pN : so.forces_pN) {
+    const double f = f_pN * 1e-12;
+    Kokkos::deep_copy(ext, 0.0);
+    for (int i : left) ext(i, 0) = -f / left.size();
+    for (int i : right) ext(i, 0) = f / right.size();
+    Kokkos::deep_copy(model.external_force(), ext);
+    FireSettings fs;
+    fs.force_tol = std::max(1e-4 * 200e-12 / left.size(), 1e-17);
+    const FireResult r = fire_minimize(model, fs, edge);
+    const auto x = to_host_vector(model.positions());
+    double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
+    for (int i = 0; i < n; ++i) {
+      xmin = std::min(xmin, x[3 * i]);
+      xmax = std::max(xmax, x[3 * i]);
+      ymin = std::min(ymin, x[3 * i + 1]);
+      ymax = std::max(ymax, x[3 * i + 1]);
+    }
+    forces.push_back(f);
+    da.push_back(xmax - xmin);
+    dt.push_back(ymax - ymin);
+    char line[256];
+    std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%d,%.6g\n", f, da.back(), dt.back(), r.steps, r.max_force);
+    csv << line;
+    const auto ext_h = to_host_vector(model.external_force());
+    h5.write_frame(f, x.data(), {{"external_force_N", 3, ext_h.data()}});
+    if (!options.quiet)
+      std::printf("  F = %7.2f pN   D_A = %6.3f um   D_T = %6.3f um   (%d FIRE steps, residual %.2g N%s)\n", f_pN,
+                  da.back() * 1e6, dt.back() * 1e6, r.steps, r.max_force, r.converged ? "" : ", NOT CONVERGED");
+    if (!r.converged)
+      throw NumericalError("stretch at F = " + std::to_string(f_pN) + " pN did not reach equilibrium in " +
+                           std::to_string(r.steps) + " FIRE steps (largest node force " +
+                           std::to_string(r.max_force) + " N)");
+  }
+  csv.close();
+  std::rename((out + "/series.csv.tmp").c_str(), (out + "/series.csv").c_str());
+  h5.close();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  JsonObject summary;
+  summary.add("scene", scene.name())
+      .add("nodes", n)
+      .add("pulled_nodes_per_end", static_cast<long long>(left.size()))
+      .add("forces_N", forces)
+      .add("DA_m", da)
+      .add("DT_m", dt)
+      .add("wall_s", wall);
+  summary.write(out + "/summary.json");
+  if (!options.quiet) std::printf("  wrote %s/series.csv, summary.json, stretch.h5 (%.1f s)\n", out.c_str(), wall);
+}
+
+}  // namespace
+}  // namespace dcm
+
+int main(int argc, char** argv) {
+  CLI::App app("The optical-tweezers stretching experiment (paper Figure 2): pull the outermost nodes at both\n"
+               "ends with +-F/n, find the equilibrium, record the axial and transverse diameters.",
+               "stretch");
+  dcm::AppOptions options;
+  dcm::StretchOptions so;
+  dcm::add_common_options(app, options);
+  app.add_option("--forces-pN", so.forces_pN, "Stretching forces in pN (default: the Mills 2004 forces and 200)")
+      ->delimiter(',');
+  return dcm::run_app(app, argc, argv, [&] { dcm::run(options, so); });
+}

@@ -1,0 +1,233 @@
+#pragma once
+// The cortex of one or more cells as a mechanical system: positions, the enabled force terms with their
+// rest states, external node forces, and the friction operator. Host-side composition: a term the
+// parameters switch off (constant 0) is not constructed and costs nothing.
+//
+//   compute_forces(): geometry, then F = Σ enabled terms + external (paper eq. 32, left-hand side)
+//   energy():         Σ term energies − Σ F_ext · x (a Lyapunov function of the overdamped flow)
+//   solve_velocity(): Γ v = F by PCG, warm-started from the previous v
+//
+// Numerical trouble (a FENE bond at d_max, a non-finite force or velocity) throws NumericalError naming
+// the term and the node or bond; callers add the step.
+#include <cmath>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "core/host_copy.hpp"
+#include "core/update_geometry.hpp"
+#include "kernels/area_constraints.hpp"
+#include "kernels/bending.hpp"
+#include "kernels/external_forces.hpp"
+#include "kernels/fene_pow_bonds.hpp"
+#include "kernels/volume_constraint.hpp"
+#include "solvers/friction_operator.hpp"
+#include "solvers/pcg.hpp"
+
+namespace dcm {
+
+// Constants in the units of the energies of docs/model/ (SI). See mechanics_from_scene() for how the
+// paper's Table 1 numbers map onto them.
+struct MechanicsParams {
+  FenePowParams bonds;         // k_s (N/m), x_max
+  double k_b = 0;              // J, bending
+  double k_area_local = 0;     // N/m, E = Σ k (A_t − A_t*)² / (2 A_t*)
+  double k_area_global = 0;    // N/m, E = k (A − A*)² / (2 A*)
+  double k_volume = 0;         // Pa,  E = k (V − V*)² / (2 V*)
+  double dashpot = 0;          // c (N·s/m)
+  double viscosity = 0.8e-3;   // η (Pa·s), Stokes drag 6πηr/N per node
+  double h_min = 1e4;          // 1/m, triangle curvature clamp
+};
+
+// Index of the first node with a non-finite component, or -1.
+template <class ExecutionSpace, class Vector>
+int first_non_finite_node(const ExecutionSpace& space, const Vector& v) {
+  const int n = static_cast<int>(v.extent(0));
+  int first = n;
+  Kokkos::parallel_reduce(
+      "dcm::model::check_finite", Kokkos::RangePolicy<ExecutionSpace>(space, 0, n),
+      KOKKOS_LAMBDA(const int i, int& m) {
+        const bool ok = math::isfinite(v(i, 0)) && math::isfinite(v(i, 1)) && math::isfinite(v(i, 2));
+        if (!ok && i < m) m = i;
+      },
+      Kokkos::Min<int>(first));
+  return first < n ? first : -1;
+}
+
+template <class ExecutionSpace>
+class CortexModel {
+ public:
+  using Mem = typename ExecutionSpace::memory_space;
+  using Vector = Kokkos::View<double* [3], Kokkos::LayoutRight, Mem>;
+
+  // The rest state of every term is the shape the cells are given in.
+  CortexModel(const ExecutionSpace& space, const std::vector<HostCell>& cells, const MechanicsParams& p)
+      : space_(space),
+        params_(p),
+        mesh_(upload_cells<Mem>(cells)),
+        geo_(mesh_),
+        force_(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::model::force"), mesh_.n_nodes),
+        velocity_("dcm::model::velocity", mesh_.n_nodes),
+        external_("dcm::model::external_force", mesh_.n_nodes),
+        overstretched_("dcm::model::overstretched"),
+        cg_(mesh_.n_nodes) {
+    update_geometry(space_, mesh_, geo_, p.h_min);
+    if (p.bonds.k_s > 0) bonds_ = make_bond_rest(space_, mesh_);
+    if (p.k_b > 0) hinges_ = make_hinge_rest(space_, mesh_);
+    if (p.k_area_local > 0 || p.k_area_global > 0) area_ = make_area_rest(space_, mesh_, geo_);
+    if (p.k_volume > 0) volume_ = make_volume_rest(space_, mesh_, geo_);
+    friction_ = FrictionOperator<Mem>(mesh_, node_drag(cells), p.dashpot);
+  }
+
+  const MeshBuffers<Mem>& mesh() const { return mesh_; }
+  const GeometryBuffers<Mem>& geometry() const { return geo_; }
+  const MechanicsParams& params() const { return params_; }
+  const Vector& positions() const { return mesh_.x; }
+  const Vector& force() const { return force_; }
+  const Vector& velocity() const { return velocity_; }
+  const Vector& external_force() const { return external_; }  // set by the caller; zero at start
+  const ExecutionSpace& space() const { return space_; }
+  const FrictionOperator<Mem>& friction() const { return friction_; }
+
+  // Geometry, then the total force on every node.
+  void compute_forces() {
+    update_geometry(space_, mesh_, geo_, params_.h_min);
+    Kokkos::deep_copy(space_, force_, 0.0);
+    if (bonds_) {
+      Kokkos::deep_copy(space_, overstretched_, -1);
+      add_fene_pow_forces(space_, mesh_, *bonds_, params_.bonds, force_, overstretched_);
+      int bad = -1;
+      Kokkos::deep_copy(bad, overstretched_);
+      if (bad >= 0) throw NumericalError(describe_overstretch(bad));
+    }
+    if (hinges_) add_bending_forces(space_, mesh_, *hinges_, params_.k_b, force_);
+    if (area_) add_area_forces(space_, mesh_, geo_, *area_, params_.k_area_local, params_.k_area_global, force_);
+    if (volume_) add_volume_forces(space_, mesh_, geo_, *volume_, params_.k_volume, force_);
+    add_external_forces(space_, external_, force_);
+    const int bad_node = first_non_finite_node(space_, force_);
+    if (bad_node >= 0) throw NumericalError("non-finite force at node " + std::to_string(bad_node) + " (term: " +
+                                            term_with_non_finite_force(bad_node) + ")");
+  }
+
+  // Total energy for the current positions (calls update_geometry()).
+  double energy() {
+    update_geometry(space_, mesh_, geo_, params_.h_min);
+    double e = external_energy(space_, external_, mesh_.x);
+    if (bonds_) e += fene_pow_energy(space_, mesh_, *bonds_, params_.bonds);
+    if (hinges_) e += bending_energy(space_, mesh_, *hinges_, params_.k_b);
+    if (area_) e += area_energy(space_, mesh_, geo_, *area_, params_.k_area_local, params_.k_area_global);
+    if (volume_) e += volume_energy(space_, mesh_, geo_, *volume_, params_.k_volume);
+    return e;
+  }
+
+  // Γ v = F for the current positions and forces (compute_forces() first). Without dashpots Γ is diagonal
+  // and the solve is one division per node.
+  CgResult solve_velocity(const CgSettings& settings) {
+    update_friction(space_, mesh_, friction_);
+    if (params_.dashpot == 0) {
+      apply_block_jacobi(space_, friction_, force_, velocity_);
+      CgResult r;
+      r.converged = true;
+      return r;
+    }
+    const CgResult r = pcg_solve(
+        space_, [&](const Vector& in, const Vector& out) { apply_friction(space_, mesh_, friction_, in, out); },
+        [&](const Vector& in, const Vector& out) { apply_block_jacobi(space_, friction_, in, out); }, force_,
+        velocity_, cg_, settings);
+    if (!r.converged && !(r.residual_norm < INFINITY))
+      throw NumericalError("conjugate gradients diverged (residual " + std::to_string(r.residual_norm) + " N)");
+    if (!r.converged)
+      throw NumericalError("conjugate gradients did not converge in " + std::to_string(r.iterations) +
+                           " iterations (residual " + std::to_string(r.residual_norm) + " N, tolerance " +
+                           std::to_string(settings.abs_tol) + " N); raise solver.cg_max_iterations");
+    const int bad = first_non_finite_node(space_, velocity_);
+    if (bad >= 0) throw NumericalError("non-finite velocity at node " + std::to_string(bad) + " after the solve");
+    return r;
+  }
+
+  // x += dt v (forward Euler, paper eq. 32 integrated explicitly).
+  void advance(double dt) {
+    const auto x = mesh_.x;
+    const auto v = velocity_;
+    Kokkos::parallel_for(
+        "dcm::integrator::euler", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_nodes),
+        KOKKOS_LAMBDA(const int i) {
+          for (int d = 0; d < 3; ++d) x(i, d) += dt * v(i, d);
+        });
+  }
+
+  // vᵀ Γ v: the power dissipated by the friction (W), for the energy balance.
+  double dissipation() {
+    apply_friction(space_, mesh_, friction_, velocity_, cg_.q);
+    return cg_detail::dot(space_, velocity_, cg_.q);
+  }
+
+ private:
+  // ζ_i = 6 π η r / N per cell, r the radius of the sphere with the cell's rest area.
+  Kokkos::View<double*, Kokkos::LayoutRight, Mem> node_drag(const std::vector<HostCell>& cells) {
+    Kokkos::View<double*, Kokkos::LayoutRight, Mem> drag("dcm::model::node_drag", mesh_.n_nodes);
+    auto h = Kokkos::create_mirror_view(drag);
+    const auto area = to_host_vector(geo_.cell_area);
+    constexpr double pi = 3.14159265358979323846;
+    int i = 0;
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      const int n = static_cast<int>(cells[c].mesh.nodes.size());
+      const double r = std::sqrt(area[c] / (4 * pi));
+      for (int k = 0; k < n; ++k) h(i++) = 6 * pi * params_.viscosity * r / n;
+    }
+    Kokkos::deep_copy(drag, h);
+    return drag;
+  }
+
+  // Failure path only: evaluates each term alone to name the one that produced the non-finite value.
+  std::string term_with_non_finite_force(int node) {
+    Vector scratch("dcm::model::scratch", mesh_.n_nodes);
+    auto check = [&](const char* name, auto&& add) -> std::string {
+      Kokkos::deep_copy(scratch, 0.0);
+      add();
+      auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), scratch);
+      for (int d = 0; d < 3; ++d)
+        if (!std::isfinite(h(node, d))) return name;
+      return "";
+    };
+    std::string t;
+    if (bonds_ && (t = check("FENE+POW bonds", [&] {
+                    add_fene_pow_forces(space_, mesh_, *bonds_, params_.bonds, scratch, overstretched_);
+                  })) != "")
+      return t;
+    if (hinges_ && (t = check("bending", [&] { add_bending_forces(space_, mesh_, *hinges_, params_.k_b, scratch); })) != "")
+      return t;
+    if (area_ && (t = check("area constraints", [&] {
+                   add_area_forces(space_, mesh_, geo_, *area_, params_.k_area_local, params_.k_area_global, scratch);
+                 })) != "")
+      return t;
+    if (volume_ &&
+        (t = check("volume constraint", [&] { add_volume_forces(space_, mesh_, geo_, *volume_, params_.k_volume, scratch); })) != "")
+      return t;
+    return "external force or positions";
+  }
+
+  std::string describe_overstretch(int bond) const {
+    auto b = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh_.bond);
+    return "FENE bond " + std::to_string(bond) + " (nodes " + std::to_string(b(bond, 0)) + "-" +
+           std::to_string(b(bond, 1)) + ") reached its maximum length d_max = x_max d* (x_max = " +
+           std::to_string(params_.bonds.x_max) + "); reduce the time step or the load";
+  }
+
+  ExecutionSpace space_;
+  MechanicsParams params_;
+  MeshBuffers<Mem> mesh_;
+  GeometryBuffers<Mem> geo_;
+  Vector force_, velocity_, external_;
+  Kokkos::View<int, Mem> overstretched_;
+  std::optional<BondRest<Mem>> bonds_;
+  std::optional<HingeRest<Mem>> hinges_;
+  std::optional<AreaRest<Mem>> area_;
+  std::optional<VolumeRest<Mem>> volume_;
+  FrictionOperator<Mem> friction_;
+  CgWorkspace<Mem> cg_;
+};
+
+}  // namespace dcm
