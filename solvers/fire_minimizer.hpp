@@ -8,6 +8,7 @@
 // Converged when max_i |F_i| ≤ force_tol (N). Masses are uniform; the step is in units where the
 // "mass" is 1 kg·(mass_scale): only the product dt²/m matters, chosen automatically from the stiffness.
 #include <cmath>
+#include <cstdio>
 
 #include "solvers/cortex_model.hpp"
 
@@ -19,6 +20,7 @@ struct FireSettings {
   double dt_start = 0;       // 0: chosen from the initial forces (a step moving the fastest node ~1e-3 edge)
   int n_min = 5;
   double f_inc = 1.1, f_dec = 0.5, alpha_start = 0.1, f_alpha = 0.99, dt_max_factor = 10;
+  int trace_every = 0;  // > 0: print progress to stderr every so many steps
 };
 
 struct FireResult {
@@ -80,6 +82,12 @@ FireResult fire_minimize(CortexModel<ExecutionSpace>& model, const FireSettings&
         alpha *= s.f_alpha;
       }
     } else {
+      // FIRE 2.0 (Guénolé et al. 2020): step half back before stopping, which damps the overshoot.
+      const double back = 0.5 * dt;
+      Kokkos::parallel_for(
+          "dcm::fire::back", Policy(space, 0, n), KOKKOS_LAMBDA(const int i) {
+            for (int d = 0; d < 3; ++d) x(i, d) -= back * u(i, d);
+          });
       Kokkos::deep_copy(space, u, 0.0);
       dt *= s.f_dec;
       alpha = s.alpha_start;
@@ -108,6 +116,9 @@ FireResult fire_minimize(CortexModel<ExecutionSpace>& model, const FireSettings&
     }
     ++r.force_evaluations;
     r.max_force = max_force();
+    if (s.trace_every > 0 && r.steps % s.trace_every == 0)
+      std::fprintf(stderr, "  FIRE step %d: max |F| = %.3e N, dt = %.3e, alpha = %.3f\n", r.steps, r.max_force, dt,
+                   alpha);
   }
   return r;
 }

@@ -5,6 +5,7 @@
 // per force, and <out>/stretch.png against ../shared/data/stretching when plotting is available.
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <numeric>
@@ -14,6 +15,7 @@
 
 #include "apps/common/app_cli.hpp"
 #include "apps/common/mechanics_setup.hpp"
+#include "apps/common/stretch_setup.hpp"
 #include "core/h5_output.hpp"
 #include "core/host_copy.hpp"
 #include "core/json_writer.hpp"
@@ -32,15 +34,6 @@ struct StretchOptions {
   bool plot = true;
 };
 
-// Node indices of the outermost `fraction` of nodes at the -x and +x ends.
-std::pair<std::vector<int>, std::vector<int>> pulled_nodes(const HostMesh& m, double fraction) {
-  std::vector<int> order(m.nodes.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return m.nodes[a][0] < m.nodes[b][0]; });
-  const std::size_t n = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(fraction * m.nodes.size())));
-  return {std::vector<int>(order.begin(), order.begin() + n), std::vector<int>(order.end() - n, order.end())};
-}
-
 void run(const AppOptions& options, const StretchOptions& so) {
   const Scene scene = load_scene(options);
   for (double f : so.forces_pN)
@@ -54,16 +47,7 @@ void run(const AppOptions& options, const StretchOptions& so) {
   MechanicsParams params = mechanics_from_scene(scene);
   CortexModel<Exec> model(Exec(), {HostCell(mesh)}, params);
   const int n = model.mesh().n_nodes;
-  double edge = 0;
-  {
-    const Topology& t = build_topology(mesh);
-    for (const auto& e : t.edges) {
-      const auto& a = mesh.nodes[e[0]];
-      const auto& b = mesh.nodes[e[1]];
-      edge += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
-    }
-    edge /= t.edges.size();
-  }
+  const double edge = mean_edge_length(mesh, build_topology(mesh));
   if (!options.quiet)
     std::printf("dcm stretch: scene '%s', %s, %d nodes, %zu pulled at each end; %s\n", scene.name().c_str(),
                 scene.get_string("mesh.shape").c_str(), n, left.size(), kokkos_description().c_str());
@@ -88,18 +72,13 @@ void run(const AppOptions& options, const StretchOptions& so) {
     Kokkos::deep_copy(model.external_force(), ext);
     FireSettings fs;
     fs.force_tol = std::max(1e-4 * 200e-12 / left.size(), 1e-17);
+    if (const char* trace = std::getenv("DCM_FIRE_TRACE")) fs.trace_every = std::atoi(trace);
     const FireResult r = fire_minimize(model, fs, edge);
     const auto x = to_host_vector(model.positions());
-    double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
-    for (int i = 0; i < n; ++i) {
-      xmin = std::min(xmin, x[3 * i]);
-      xmax = std::max(xmax, x[3 * i]);
-      ymin = std::min(ymin, x[3 * i + 1]);
-      ymax = std::max(ymax, x[3 * i + 1]);
-    }
+    const auto [d_axial, d_transverse] = axial_transverse_diameters(x);
     forces.push_back(f);
-    da.push_back(xmax - xmin);
-    dt.push_back(ymax - ymin);
+    da.push_back(d_axial);
+    dt.push_back(d_transverse);
     char line[256];
     std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%d,%.6g\n", f, da.back(), dt.back(), r.steps, r.max_force);
     csv << line;

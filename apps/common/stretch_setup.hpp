@@ -1,0 +1,45 @@
+#pragma once
+// The optical-tweezers geometry shared by stretch and relax: which nodes are pulled, and the diameters.
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <utility>
+#include <vector>
+
+#include "core/host_mesh.hpp"
+
+namespace dcm {
+
+// Node indices of the outermost `fraction` of the nodes at the −x and +x ends (at least one each).
+inline std::pair<std::vector<int>, std::vector<int>> pulled_nodes(const HostMesh& m, double fraction) {
+  std::vector<int> order(m.nodes.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return m.nodes[a][0] < m.nodes[b][0]; });
+  const std::size_t n = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(fraction * m.nodes.size())));
+  return {std::vector<int>(order.begin(), order.begin() + n), std::vector<int>(order.end() - n, order.end())};
+}
+
+// Axial (x) and transverse (y) extent of positions [n][3] row major.
+inline std::pair<double, double> axial_transverse_diameters(const std::vector<double>& x) {
+  double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
+  for (std::size_t i = 0; i + 2 < x.size(); i += 3) {
+    xmin = std::min(xmin, x[i]);
+    xmax = std::max(xmax, x[i]);
+    ymin = std::min(ymin, x[i + 1]);
+    ymax = std::max(ymax, x[i + 1]);
+  }
+  return {xmax - xmin, ymax - ymin};
+}
+
+// Mean edge length of a mesh (m).
+inline double mean_edge_length(const HostMesh& mesh, const Topology& t) {
+  double sum = 0;
+  for (const auto& e : t.edges) {
+    const auto& a = mesh.nodes[e[0]];
+    const auto& b = mesh.nodes[e[1]];
+    sum += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+  }
+  return sum / t.edges.size();
+}
+
+}  // namespace dcm

@@ -1,0 +1,170 @@
+// relax: the relaxation experiment of the paper (its Figure 3): hold the cell stretched by ±F at its ends
+// until equilibrium (D_A ≈ 8.9 µm in the paper), release it, and follow D_A(t), D_T(t) under the
+// overdamped dynamics with the bond dashpots. The relaxation time t_c is fitted to Hochmuth's form
+//   (λ − λ∞)/(λ + λ∞) = [(λ₀ − λ∞)/(λ₀ + λ∞)] exp(−t/t_c),  λ = D_A/D_T,
+// with λ∞ the ratio of the unstressed shape. Writes <out>/series.csv (t_s,DA_m,DT_m,energy_J,
+// dissipation_W,cg_iterations), <out>/summary.json (relaxation_time_s, ...), <out>/relax.h5 (+ .xmf).
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "apps/common/app_cli.hpp"
+#include "apps/common/mechanics_setup.hpp"
+#include "apps/common/stretch_setup.hpp"
+#include "core/h5_output.hpp"
+#include "core/host_copy.hpp"
+#include "core/json_writer.hpp"
+#include "core/kokkos_compat.hpp"
+#include "solvers/fire_minimizer.hpp"
+
+namespace dcm {
+namespace {
+
+using Exec = Kokkos::DefaultExecutionSpace;
+
+struct RelaxOptions {
+  double hold_force_pN = 13.0;
+  double duration_s = 0.6;
+  int sample_every = 100;  // steps between samples of the series
+};
+
+// Least-squares slope of log(y) against t over the samples with y > floor; returns −1/slope.
+double fit_relaxation_time(const std::vector<double>& t, const std::vector<double>& y, double floor) {
+  double st = 0, sy = 0, stt = 0, sty = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (!(y[i] > floor)) break;
+    const double ly = std::log(y[i]);
+    st += t[i];
+    sy += ly;
+    stt += t[i] * t[i];
+    sty += t[i] * ly;
+    ++n;
+  }
+  if (n < 3) return NAN;
+  const double slope = (n * sty - st * sy) / (n * stt - st * st);
+  return -1.0 / slope;
+}
+
+void run(const AppOptions& options, const RelaxOptions& ro) {
+  const Scene scene = load_scene(options);
+  if (!(ro.hold_force_pN > 0 && ro.hold_force_pN <= 1e4))
+    throw SceneError("--hold-force-pN = " + std::to_string(ro.hold_force_pN) + " is out of range: allowed > 0 .. 10000");
+  if (!(ro.duration_s > 0 && ro.duration_s <= 100))
+    throw SceneError("--duration-s = " + std::to_string(ro.duration_s) + " is out of range: allowed > 0 .. 100");
+  const std::string out = prepare_output_dir(options, scene);
+  KokkosSession kokkos(options.threads);
+  const auto wall0 = std::chrono::steady_clock::now();
+
+  const HostMesh mesh = cell_mesh_from_scene(scene);
+  const auto [left, right] = pulled_nodes(mesh, 0.05);
+  CortexModel<Exec> model(Exec(), {HostCell(mesh)}, mechanics_from_scene(scene));
+  const int n = model.mesh().n_nodes;
+  const auto [da_rest, dt_rest] = axial_transverse_diameters(to_host_vector(model.positions()));
+  const double lambda_inf = da_rest / dt_rest;
+
+  // 1. Hold: equilibrium under ±F.
+  auto ext = Kokkos::create_mirror_view(model.external_force());
+  Kokkos::deep_copy(ext, 0.0);
+  for (int i : left) ext(i, 0) = -ro.hold_force_pN * 1e-12 / left.size();
+  for (int i : right) ext(i, 0) = ro.hold_force_pN * 1e-12 / right.size();
+  Kokkos::deep_copy(model.external_force(), ext);
+  FireSettings fs;
+  fs.force_tol = 1e-4 * ro.hold_force_pN * 1e-12 / left.size();
+  const FireResult held = fire_minimize(model, fs, mean_edge_length(mesh, build_topology(mesh)));
+  if (!held.converged) throw NumericalError("the stretched cell did not reach equilibrium before the release");
+  const auto [da0, dt0] = axial_transverse_diameters(to_host_vector(model.positions()));
+  if (!options.quiet)
+    std::printf("dcm relax: %d nodes, held at %.3g pN: D_A = %.3f um, D_T = %.3f um; released; %s\n", n,
+                ro.hold_force_pN, da0 * 1e6, dt0 * 1e6, kokkos_description().c_str());
+
+  // 2. Release and follow the overdamped dynamics.
+  Kokkos::deep_copy(model.external_force(), 0.0);
+  const double dt = scene.get_real("time.dt_s");
+  const long long steps = std::llround(ro.duration_s / dt);
+  CgSettings cg;  // the paper's absolute force residual
+  std::vector<int> tri, node_cell(n, 0);
+  for (const Tri& t : mesh.triangles) tri.insert(tri.end(), t.begin(), t.end());
+  H5Output h5(out + "/relax.h5");
+  h5.write_text("scene", scene.to_toml());
+  h5.write_mesh(to_host_vector(model.positions()).data(), n, tri.data(), static_cast<int>(mesh.triangles.size()),
+                node_cell.data());
+  std::ofstream csv(out + "/series.csv.tmp");
+  csv << "t_s,DA_m,DT_m,energy_J,dissipation_W,cg_iterations\n";
+  std::vector<double> ts, ys;
+  const double y0 = (da0 / dt0 - lambda_inf) / (da0 / dt0 + lambda_inf);
+  long long cg_total = 0;
+  int cg_max = 0;
+  for (long long step = 0; step <= steps; ++step) {
+    const double t = step * dt;
+    CgResult r;
+    try {
+      model.compute_forces();
+      r = model.solve_velocity(cg);
+    } catch (const NumericalError& e) {
+      throw NumericalError("step " + std::to_string(step) + " (t = " + std::to_string(t) + " s): " + e.what());
+    }
+    cg_total += r.iterations;
+    cg_max = std::max(cg_max, r.iterations);
+    if (step % ro.sample_every == 0) {
+      const auto x = to_host_vector(model.positions());
+      const auto [da, dtr] = axial_transverse_diameters(x);
+      const double dissipation = model.dissipation();
+      const double energy = model.energy();
+      char line[256];
+      std::snprintf(line, sizeof line, "%.9g,%.17g,%.17g,%.17g,%.17g,%d\n", t, da, dtr, energy, dissipation,
+                    r.iterations);
+      csv << line;
+      ts.push_back(t);
+      ys.push_back((da / dtr - lambda_inf) / (da / dtr + lambda_inf));
+      if (step % (ro.sample_every * 20) == 0) {
+        h5.write_frame(t, x.data(), {});
+        if (!options.quiet)
+          std::printf("  t = %.4f s  D_A = %.3f um  D_T = %.3f um  CG %d it  (%.0f%%)\n", t, da * 1e6, dtr * 1e6,
+                      r.iterations, 100.0 * step / steps);
+      }
+    }
+    model.advance(dt);
+  }
+  csv.close();
+  std::rename((out + "/series.csv.tmp").c_str(), (out + "/series.csv").c_str());
+  h5.close();
+  const double tc = fit_relaxation_time(ts, ys, 0.05 * y0);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  JsonObject summary;
+  summary.add("scene", scene.name())
+      .add("nodes", n)
+      .add("hold_force_N", ro.hold_force_pN * 1e-12)
+      .add("DA_held_m", da0)
+      .add("DT_held_m", dt0)
+      .add("lambda_inf", lambda_inf)
+      .add("relaxation_time_s", tc)
+      .add("dt_s", dt)
+      .add("steps", steps)
+      .add("mean_cg_iterations", static_cast<double>(cg_total) / (steps + 1))
+      .add("max_cg_iterations", cg_max)
+      .add("wall_s", wall);
+  summary.write(out + "/summary.json");
+  if (!options.quiet)
+    std::printf("  relaxation time t_c = %.4g s; mean CG iterations %.1f (max %d); %.1f s\n", tc,
+                static_cast<double>(cg_total) / (steps + 1), cg_max, wall);
+}
+
+}  // namespace
+}  // namespace dcm
+
+int main(int argc, char** argv) {
+  CLI::App app("The relaxation experiment (paper Figure 3): hold the cell stretched, release it, follow\n"
+               "D_A(t) and D_T(t), fit the relaxation time.",
+               "relax");
+  dcm::AppOptions options;
+  dcm::RelaxOptions ro;
+  dcm::add_common_options(app, options);
+  app.add_option("--hold-force-pN", ro.hold_force_pN, "Force holding the cell before the release (pN)");
+  app.add_option("--duration-s", ro.duration_s, "Simulated time after the release (s)");
+  app.add_option("--sample-every", ro.sample_every, "Steps between rows of series.csv")->check(CLI::Range(1, 1000000));
+  return dcm::run_app(app, argc, argv, [&] { dcm::run(options, ro); });
+}
