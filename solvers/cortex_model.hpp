@@ -31,14 +31,14 @@ namespace dcm {
 // Constants in the units of the energies of docs/model/ (SI). See mechanics_from_scene() for how the
 // paper's Table 1 numbers map onto them.
 struct MechanicsParams {
-  FenePowParams bonds;         // k_s (N/m), x_max
-  double k_b = 0;              // J, bending
-  double k_area_local = 0;     // N/m, E = Σ k (A_t − A_t*)² / (2 A_t*)
-  double k_area_global = 0;    // N/m, E = k (A − A*)² / (2 A*)
-  double k_volume = 0;         // Pa,  E = k (V − V*)² / (2 V*)
-  double dashpot = 0;          // c (N·s/m)
-  double viscosity = 0.8e-3;   // η (Pa·s), Stokes drag 6πηr/N per node
-  double h_min = 1e4;          // 1/m, triangle curvature clamp
+  FenePowParams bonds;        // k_s (N/m), x_max
+  double k_b = 0;             // J, bending
+  double k_area_local = 0;    // N/m, E = Σ k (A_t − A_t*)² / (2 A_t*)
+  double k_area_global = 0;   // N/m, E = k (A − A*)² / (2 A*)
+  double k_volume = 0;        // Pa,  E = k (V − V*)² / (2 V*)
+  double dashpot = 0;         // c (N·s/m)
+  double viscosity = 0.8e-3;  // η (Pa·s), Stokes drag 6πηr/N per node
+  double h_min = 1e4;         // 1/m, triangle curvature clamp
 };
 
 // Index of the first node with a non-finite component, or -1.
@@ -103,12 +103,14 @@ class CortexModel {
       if (bad >= 0) throw NumericalError(describe_overstretch(bad));
     }
     if (hinges_) add_bending_forces(space_, mesh_, *hinges_, params_.k_b, force_);
-    if (area_) add_area_forces(space_, mesh_, geo_, *area_, params_.k_area_local, params_.k_area_global, force_);
+    if (area_)
+      add_area_forces(space_, mesh_, geo_, *area_, params_.k_area_local, params_.k_area_global, force_);
     if (volume_) add_volume_forces(space_, mesh_, geo_, *volume_, params_.k_volume, force_);
     add_external_forces(space_, external_, force_);
     const int bad_node = first_non_finite_node(space_, force_);
-    if (bad_node >= 0) throw NumericalError("non-finite force at node " + std::to_string(bad_node) + " (term: " +
-                                            term_with_non_finite_force(bad_node) + ")");
+    if (bad_node >= 0)
+      throw NumericalError("non-finite force at node " + std::to_string(bad_node) +
+                           " (term: " + term_with_non_finite_force(bad_node) + ")");
   }
 
   // Total energy for the current positions (calls update_geometry()).
@@ -133,17 +135,20 @@ class CortexModel {
       return r;
     }
     const CgResult r = pcg_solve(
-        space_, [&](const Vector& in, const Vector& out) { apply_friction(space_, mesh_, friction_, in, out); },
+        space_,
+        [&](const Vector& in, const Vector& out) { apply_friction(space_, mesh_, friction_, in, out); },
         [&](const Vector& in, const Vector& out) { apply_block_jacobi(space_, friction_, in, out); }, force_,
         velocity_, cg_, settings);
     if (!r.converged && !(r.residual_norm < INFINITY))
-      throw NumericalError("conjugate gradients diverged (residual " + std::to_string(r.residual_norm) + " N)");
+      throw NumericalError("conjugate gradients diverged (residual " + std::to_string(r.residual_norm) +
+                           " N)");
     if (!r.converged)
       throw NumericalError("conjugate gradients did not converge in " + std::to_string(r.iterations) +
                            " iterations (residual " + std::to_string(r.residual_norm) + " N, tolerance " +
                            std::to_string(settings.abs_tol) + " N); raise solver.cg_max_iterations");
     const int bad = first_non_finite_node(space_, velocity_);
-    if (bad >= 0) throw NumericalError("non-finite velocity at node " + std::to_string(bad) + " after the solve");
+    if (bad >= 0)
+      throw NumericalError("non-finite velocity at node " + std::to_string(bad) + " after the solve");
     return r;
   }
 
@@ -194,17 +199,21 @@ class CortexModel {
     };
     std::string t;
     if (bonds_ && (t = check("FENE+POW bonds", [&] {
-                    add_fene_pow_forces(space_, mesh_, *bonds_, params_.bonds, scratch, overstretched_);
-                  })) != "")
+                     add_fene_pow_forces(space_, mesh_, *bonds_, params_.bonds, scratch, overstretched_);
+                   })) != "")
       return t;
-    if (hinges_ && (t = check("bending", [&] { add_bending_forces(space_, mesh_, *hinges_, params_.k_b, scratch); })) != "")
+    if (hinges_ && (t = check("bending", [&] {
+                      add_bending_forces(space_, mesh_, *hinges_, params_.k_b, scratch);
+                    })) != "")
       return t;
     if (area_ && (t = check("area constraints", [&] {
-                   add_area_forces(space_, mesh_, geo_, *area_, params_.k_area_local, params_.k_area_global, scratch);
-                 })) != "")
+                    add_area_forces(space_, mesh_, geo_, *area_, params_.k_area_local, params_.k_area_global,
+                                    scratch);
+                  })) != "")
       return t;
-    if (volume_ &&
-        (t = check("volume constraint", [&] { add_volume_forces(space_, mesh_, geo_, *volume_, params_.k_volume, scratch); })) != "")
+    if (volume_ && (t = check("volume constraint", [&] {
+                      add_volume_forces(space_, mesh_, geo_, *volume_, params_.k_volume, scratch);
+                    })) != "")
       return t;
     return "external force or positions";
   }
@@ -212,8 +221,9 @@ class CortexModel {
   std::string describe_overstretch(int bond) const {
     auto b = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh_.bond);
     return "FENE bond " + std::to_string(bond) + " (nodes " + std::to_string(b(bond, 0)) + "-" +
-           std::to_string(b(bond, 1)) + ") reached its maximum length d_max = x_max d* (x_max = " +
-           std::to_string(params_.bonds.x_max) + "); reduce the time step or the load";
+           std::to_string(b(bond, 1)) +
+           ") reached its maximum length d_max = x_max d* (x_max = " + std::to_string(params_.bonds.x_max) +
+           "); reduce the time step or the load";
   }
 
   ExecutionSpace space_;

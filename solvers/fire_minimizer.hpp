@@ -17,7 +17,7 @@ namespace dcm {
 struct FireSettings {
   double force_tol = 1e-15;  // N, largest node force at equilibrium
   int max_steps = 200000;
-  double dt_start = 0;       // 0: chosen from the initial forces (a step moving the fastest node ~1e-3 edge)
+  double dt_start = 0;  // 0: chosen from the initial forces (a step moving the fastest node ~1e-3 edge)
   int n_min = 5;
   double f_inc = 1.1, f_dec = 0.5, alpha_start = 0.1, f_alpha = 0.99, dt_max_factor = 10;
   int trace_every = 0;  // > 0: print progress to stderr every so many steps
@@ -117,8 +117,8 @@ FireResult fire_minimize(CortexModel<ExecutionSpace>& model, const FireSettings&
     ++r.force_evaluations;
     r.max_force = max_force();
     if (s.trace_every > 0 && r.steps % s.trace_every == 0)
-      std::fprintf(stderr, "  FIRE step %d: max |F| = %.3e N, dt = %.3e, alpha = %.3f\n", r.steps, r.max_force, dt,
-                   alpha);
+      std::fprintf(stderr, "  FIRE step %d: max |F| = %.3e N, dt = %.3e, alpha = %.3f\n", r.steps,
+                   r.max_force, dt, alpha);
   }
   return r;
 }

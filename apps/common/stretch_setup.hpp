@@ -15,7 +15,8 @@ inline std::pair<std::vector<int>, std::vector<int>> pulled_nodes(const HostMesh
   std::vector<int> order(m.nodes.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return m.nodes[a][0] < m.nodes[b][0]; });
-  const std::size_t n = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(fraction * m.nodes.size())));
+  const std::size_t n =
+      std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(fraction * m.nodes.size())));
   return {std::vector<int>(order.begin(), order.begin() + n), std::vector<int>(order.end() - n, order.end())};
 }
 
@@ -37,7 +38,8 @@ inline double mean_edge_length(const HostMesh& mesh, const Topology& t) {
   for (const auto& e : t.edges) {
     const auto& a = mesh.nodes[e[0]];
     const auto& b = mesh.nodes[e[1]];
-    sum += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+    sum += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                     (a[2] - b[2]) * (a[2] - b[2]));
   }
   return sum / t.edges.size();
 }

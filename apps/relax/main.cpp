@@ -52,9 +52,11 @@ double fit_relaxation_time(const std::vector<double>& t, const std::vector<doubl
 void run(const AppOptions& options, const RelaxOptions& ro) {
   const Scene scene = load_scene(options);
   if (!(ro.hold_force_pN > 0 && ro.hold_force_pN <= 1e4))
-    throw SceneError("--hold-force-pN = " + std::to_string(ro.hold_force_pN) + " is out of range: allowed > 0 .. 10000");
+    throw SceneError("--hold-force-pN = " + std::to_string(ro.hold_force_pN) +
+                     " is out of range: allowed > 0 .. 10000");
   if (!(ro.duration_s > 0 && ro.duration_s <= 100))
-    throw SceneError("--duration-s = " + std::to_string(ro.duration_s) + " is out of range: allowed > 0 .. 100");
+    throw SceneError("--duration-s = " + std::to_string(ro.duration_s) +
+                     " is out of range: allowed > 0 .. 100");
   const std::string out = prepare_output_dir(options, scene);
   KokkosSession kokkos(options.threads);
   const auto wall0 = std::chrono::steady_clock::now();
@@ -75,7 +77,8 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
   FireSettings fs;
   fs.force_tol = 1e-4 * ro.hold_force_pN * 1e-12 / left.size();
   const FireResult held = fire_minimize(model, fs, mean_edge_length(mesh, build_topology(mesh)));
-  if (!held.converged) throw NumericalError("the stretched cell did not reach equilibrium before the release");
+  if (!held.converged)
+    throw NumericalError("the stretched cell did not reach equilibrium before the release");
   const auto [da0, dt0] = axial_transverse_diameters(to_host_vector(model.positions()));
   if (!options.quiet)
     std::printf("dcm relax: %d nodes, held at %.3g pN: D_A = %.3f um, D_T = %.3f um; released; %s\n", n,
@@ -90,8 +93,8 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
   for (const Tri& t : mesh.triangles) tri.insert(tri.end(), t.begin(), t.end());
   H5Output h5(out + "/relax.h5");
   h5.write_text("scene", scene.to_toml());
-  h5.write_mesh(to_host_vector(model.positions()).data(), n, tri.data(), static_cast<int>(mesh.triangles.size()),
-                node_cell.data());
+  h5.write_mesh(to_host_vector(model.positions()).data(), n, tri.data(),
+                static_cast<int>(mesh.triangles.size()), node_cell.data());
   std::ofstream csv(out + "/series.csv.tmp");
   csv << "t_s,DA_m,DT_m,energy_J,dissipation_W,cg_iterations\n";
   std::vector<double> ts, ys;
@@ -105,7 +108,8 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
       model.compute_forces();
       r = model.solve_velocity(cg);
     } catch (const NumericalError& e) {
-      throw NumericalError("step " + std::to_string(step) + " (t = " + std::to_string(t) + " s): " + e.what());
+      throw NumericalError("step " + std::to_string(step) + " (t = " + std::to_string(t) +
+                           " s): " + e.what());
     }
     cg_total += r.iterations;
     cg_max = std::max(cg_max, r.iterations);
@@ -123,8 +127,8 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
       if (step % (ro.sample_every * 20) == 0) {
         h5.write_frame(t, x.data(), {});
         if (!options.quiet)
-          std::printf("  t = %.4f s  D_A = %.3f um  D_T = %.3f um  CG %d it  (%.0f%%)\n", t, da * 1e6, dtr * 1e6,
-                      r.iterations, 100.0 * step / steps);
+          std::printf("  t = %.4f s  D_A = %.3f um  D_T = %.3f um  CG %d it  (%.0f%%)\n", t, da * 1e6,
+                      dtr * 1e6, r.iterations, 100.0 * step / steps);
       }
     }
     model.advance(dt);
@@ -157,14 +161,16 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
 }  // namespace dcm
 
 int main(int argc, char** argv) {
-  CLI::App app("The relaxation experiment (paper Figure 3): hold the cell stretched, release it, follow\n"
-               "D_A(t) and D_T(t), fit the relaxation time.",
-               "relax");
+  CLI::App app(
+      "The relaxation experiment (paper Figure 3): hold the cell stretched, release it, follow\n"
+      "D_A(t) and D_T(t), fit the relaxation time.",
+      "relax");
   dcm::AppOptions options;
   dcm::RelaxOptions ro;
   dcm::add_common_options(app, options);
   app.add_option("--hold-force-pN", ro.hold_force_pN, "Force holding the cell before the release (pN)");
   app.add_option("--duration-s", ro.duration_s, "Simulated time after the release (s)");
-  app.add_option("--sample-every", ro.sample_every, "Steps between rows of series.csv")->check(CLI::Range(1, 1000000));
+  app.add_option("--sample-every", ro.sample_every, "Steps between rows of series.csv")
+      ->check(CLI::Range(1, 1000000));
   return dcm::run_app(app, argc, argv, [&] { dcm::run(options, ro); });
 }

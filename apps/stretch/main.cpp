@@ -5,8 +5,8 @@
 // per force, and <out>/stretch.png against ../shared/data/stretching when plotting is available.
 #include <algorithm>
 #include <chrono>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <numeric>
 #include <sstream>
@@ -28,7 +28,7 @@ namespace {
 using Exec = Kokkos::DefaultExecutionSpace;
 
 struct StretchOptions {
-  std::vector<double> forces_pN = {0, 15.987, 19.338, 30.754, 38.365, 47.245, 67.964, 87.837,
+  std::vector<double> forces_pN = {0,       15.987,  19.338,  30.754,  38.365,  47.245, 67.964, 87.837,
                                    108.949, 130.513, 150.809, 172.374, 192.688, 200};  // Mills 2004 + 200
   double pulled_fraction = 0.05;
   bool plot = true;
@@ -37,7 +37,8 @@ struct StretchOptions {
 void run(const AppOptions& options, const StretchOptions& so) {
   const Scene scene = load_scene(options);
   for (double f : so.forces_pN)
-    if (!(f >= 0 && f <= 1e4)) throw SceneError("--forces-pN: " + std::to_string(f) + " is out of range: allowed 0 .. 10000");
+    if (!(f >= 0 && f <= 1e4))
+      throw SceneError("--forces-pN: " + std::to_string(f) + " is out of range: allowed 0 .. 10000");
   const std::string out = prepare_output_dir(options, scene);
   KokkosSession kokkos(options.threads);
   const auto wall0 = std::chrono::steady_clock::now();
@@ -80,13 +81,15 @@ void run(const AppOptions& options, const StretchOptions& so) {
     da.push_back(d_axial);
     dt.push_back(d_transverse);
     char line[256];
-    std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%d,%.6g\n", f, da.back(), dt.back(), r.steps, r.max_force);
+    std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%d,%.6g\n", f, da.back(), dt.back(), r.steps,
+                  r.max_force);
     csv << line;
     const auto ext_h = to_host_vector(model.external_force());
     h5.write_frame(f, x.data(), {{"external_force_N", 3, ext_h.data()}});
     if (!options.quiet)
-      std::printf("  F = %7.2f pN   D_A = %6.3f um   D_T = %6.3f um   (%d FIRE steps, residual %.2g N%s)\n", f_pN,
-                  da.back() * 1e6, dt.back() * 1e6, r.steps, r.max_force, r.converged ? "" : ", NOT CONVERGED");
+      std::printf("  F = %7.2f pN   D_A = %6.3f um   D_T = %6.3f um   (%d FIRE steps, residual %.2g N%s)\n",
+                  f_pN, da.back() * 1e6, dt.back() * 1e6, r.steps, r.max_force,
+                  r.converged ? "" : ", NOT CONVERGED");
     if (!r.converged)
       throw NumericalError("stretch at F = " + std::to_string(f_pN) + " pN did not reach equilibrium in " +
                            std::to_string(r.steps) + " FIRE steps (largest node force " +
@@ -105,20 +108,23 @@ void run(const AppOptions& options, const StretchOptions& so) {
       .add("DT_m", dt)
       .add("wall_s", wall);
   summary.write(out + "/summary.json");
-  if (!options.quiet) std::printf("  wrote %s/series.csv, summary.json, stretch.h5 (%.1f s)\n", out.c_str(), wall);
+  if (!options.quiet)
+    std::printf("  wrote %s/series.csv, summary.json, stretch.h5 (%.1f s)\n", out.c_str(), wall);
 }
 
 }  // namespace
 }  // namespace dcm
 
 int main(int argc, char** argv) {
-  CLI::App app("The optical-tweezers stretching experiment (paper Figure 2): pull the outermost nodes at both\n"
-               "ends with +-F/n, find the equilibrium, record the axial and transverse diameters.",
-               "stretch");
+  CLI::App app(
+      "The optical-tweezers stretching experiment (paper Figure 2): pull the outermost nodes at both\n"
+      "ends with +-F/n, find the equilibrium, record the axial and transverse diameters.",
+      "stretch");
   dcm::AppOptions options;
   dcm::StretchOptions so;
   dcm::add_common_options(app, options);
-  app.add_option("--forces-pN", so.forces_pN, "Stretching forces in pN (default: the Mills 2004 forces and 200)")
+  app.add_option("--forces-pN", so.forces_pN,
+                 "Stretching forces in pN (default: the Mills 2004 forces and 200)")
       ->delimiter(',');
   return dcm::run_app(app, argc, argv, [&] { dcm::run(options, so); });
 }

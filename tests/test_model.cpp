@@ -1,0 +1,171 @@
+// The assembled cortex model: energy balance of the overdamped flow, equilibrium by FIRE, and the
+// numerical-trouble reports.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+
+#include "core/host_copy.hpp"
+#include "solvers/fire_minimizer.hpp"
+
+namespace dcm {
+namespace {
+
+using Exec = Kokkos::DefaultExecutionSpace;
+
+MechanicsParams table1(double k_local = 6e-4, double k_global = 6e-3, double k_volume = 1e4) {
+  MechanicsParams p;
+  p.bonds = {3.2e-6, 2.05};
+  p.k_b = 240e-21;
+  p.k_area_local = k_local;
+  p.k_area_global = k_global;
+  p.k_volume = k_volume;
+  p.dashpot = 1.5e-6;
+  p.viscosity = 0.8e-3;
+  return p;
+}
+
+HostMesh perturbed_sphere(int k, double amplitude, unsigned seed) {
+  HostMesh m = make_icosphere(k, 3.25e-6);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-amplitude, amplitude);
+  for (auto& x : m.nodes)
+    for (double& v : x) v += u(rng);
+  return m;
+}
+
+// Relaxation of a perturbed cell (rest state: the unperturbed sphere) under Γ v = F, x += dt v:
+// E never increases, and (E(t+dt) − E(t))/dt = −vᵀΓv up to the O(dt) error of forward Euler.
+TEST(CortexModel, UnforcedRelaxationDissipatesEnergyAtTheRateVGammaV) {
+  const HostMesh rest = make_icosphere(2, 3.25e-6);
+  CortexModel<Exec> model(Exec(), {HostCell(rest)}, table1());
+  {  // displace the nodes from the rest shape
+    const HostMesh moved = perturbed_sphere(2, 0.04e-6, 3);
+    auto x = Kokkos::create_mirror_view(model.positions());
+    for (std::size_t i = 0; i < moved.nodes.size(); ++i)
+      for (int d = 0; d < 3; ++d) x(i, d) = moved.nodes[i][d];
+    Kokkos::deep_copy(model.positions(), x);
+  }
+  const double dt = 6e-6;
+  CgSettings cg;
+  cg.abs_tol = 0;
+  cg.rel_tol = 1e-10;
+  double e_prev = model.energy();
+  const double e_start = e_prev;
+  double worst = 0;
+  for (int step = 0; step < 300; ++step) {
+    model.compute_forces();
+    model.solve_velocity(cg);
+    const double power = model.dissipation();
+    model.advance(dt);
+    const double e = model.energy();
+    EXPECT_LE(e, e_prev) << "step " << step;
+    worst = std::fmax(worst, std::fabs((e - e_prev) / dt + power) / power);
+    e_prev = e;
+  }
+  std::printf("  energy %.4g J -> %.4g J in 300 steps; max |dE/dt + v'Gv| / v'Gv = %.3g\n", e_start, e_prev,
+              worst);
+  EXPECT_LT(e_prev, e_start);
+  EXPECT_LT(worst, 0.2);
+
+  // The residual is forward Euler's O(dt) error: from one state, halving dt halves it.
+  const auto x0 = to_host_vector(model.positions());
+  auto residual = [&](double h) {
+    auto x = Kokkos::create_mirror_view(model.positions());
+    for (std::size_t i = 0; i < x0.size() / 3; ++i)
+      for (int d = 0; d < 3; ++d) x(i, d) = x0[3 * i + d];
+    Kokkos::deep_copy(model.positions(), x);
+    const double e0 = model.energy();
+    model.compute_forces();
+    model.solve_velocity(cg);
+    const double power = model.dissipation();
+    model.advance(h);
+    return std::fabs((model.energy() - e0) / h + power) / power;
+  };
+  const double r1 = residual(dt), r2 = residual(dt / 2), r4 = residual(dt / 4);
+  std::printf("  one-step residual at dt, dt/2, dt/4: %.3g, %.3g, %.3g\n", r1, r2, r4);
+  EXPECT_NEAR(r1 / r2, 2.0, 0.3);
+  EXPECT_NEAR(r2 / r4, 2.0, 0.3);
+}
+
+TEST(CortexModel, FireFindsTheEquilibriumOfAStretchedCell) {
+  const HostMesh rest = make_icosphere(2, 3.25e-6);
+  CortexModel<Exec> model(Exec(), {HostCell(rest)}, table1(0, 6e-3, 1e4));
+  auto ext = Kokkos::create_mirror_view(model.external_force());
+  Kokkos::deep_copy(ext, 0.0);
+  int pulled = 0;
+  for (std::size_t i = 0; i < rest.nodes.size(); ++i) {
+    if (std::fabs(rest.nodes[i][0]) > 0.9 * 3.25e-6) {
+      ext(i, 0) = rest.nodes[i][0] > 0 ? 5e-12 : -5e-12;
+      ++pulled;
+    }
+  }
+  Kokkos::deep_copy(model.external_force(), ext);
+  FireSettings s;
+  s.force_tol = 1e-17;
+  const FireResult r = fire_minimize(model, s, 0.5e-6);
+  std::printf("  %d pulled nodes: FIRE converged in %d steps, max |F| = %.3g N\n", pulled, r.steps,
+              r.max_force);
+  ASSERT_TRUE(r.converged);
+  // At equilibrium the internal forces balance the pull: the model's total force is the residual.
+  EXPECT_LE(r.max_force, 1e-17);
+  const auto x = to_host_vector(model.positions());
+  double xmax = 0;
+  for (std::size_t i = 0; i < x.size(); i += 3) xmax = std::fmax(xmax, x[i]);
+  EXPECT_GT(xmax, 3.25e-6 * 1.01);  // stretched along the pull
+}
+
+TEST(CortexModel, OverstretchedBondIsReportedNotNaN) {
+  const HostMesh rest = make_icosphere(1, 3.25e-6);
+  CortexModel<Exec> model(Exec(), {HostCell(rest)}, table1());
+  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), model.positions());
+  for (int d = 0; d < 3; ++d) x(0, d) *= 3.0;  // node 0 pulled far out: its bonds pass x_max = 2.05
+  Kokkos::deep_copy(model.positions(), x);
+  try {
+    model.compute_forces();
+    FAIL() << "no NumericalError";
+  } catch (const NumericalError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("FENE bond"), std::string::npos) << what;
+    EXPECT_NE(what.find("nodes 0-"), std::string::npos) << what;
+  }
+}
+
+TEST(CortexModel, NonFiniteForceNamesTheNodeAndTerm) {
+  const HostMesh rest = make_icosphere(1, 3.25e-6);
+  MechanicsParams p = table1();
+  p.bonds.k_s = 0;  // so that the NaN reaches the other terms
+  CortexModel<Exec> model(Exec(), {HostCell(rest)}, p);
+  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), model.positions());
+  x(5, 1) = NAN;
+  Kokkos::deep_copy(model.positions(), x);
+  try {
+    model.compute_forces();
+    FAIL() << "no NumericalError";
+  } catch (const NumericalError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("non-finite force at node"), std::string::npos) << what;
+    EXPECT_NE(what.find("term:"), std::string::npos) << what;
+  }
+}
+
+TEST(CortexModel, WithoutDashpotsTheSolveIsDiagonal) {
+  MechanicsParams p = table1();
+  p.dashpot = 0;
+  CortexModel<Exec> model(Exec(), {HostCell(perturbed_sphere(2, 0.02e-6, 1))}, p);
+  model.compute_forces();
+  const CgResult r = model.solve_velocity(CgSettings{});
+  EXPECT_EQ(r.iterations, 0);
+  // v = F / ζ exactly.
+  const auto f = to_host_vector(model.force()), v = to_host_vector(model.velocity());
+  const double zeta =
+      6 * 3.14159265358979323846 * 0.8e-3 * to_host_vector(model.geometry().cell_area)[0] * 0 +
+      to_host_vector(model.friction().node_drag)[0];
+  for (std::size_t i = 0; i < f.size(); ++i)
+    EXPECT_NEAR(v[i], f[i] / zeta, 1e-12 * std::fabs(f[i] / zeta) + 1e-30);
+}
+
+}  // namespace
+}  // namespace dcm
