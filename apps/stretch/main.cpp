@@ -90,10 +90,17 @@ void run(const AppOptions& options, const StretchOptions& so) {
       std::printf("  F = %7.2f pN   D_A = %6.3f um   D_T = %6.3f um   (%d FIRE steps, residual %.2g N%s)\n",
                   f_pN, da.back() * 1e6, dt.back() * 1e6, r.steps, r.max_force,
                   r.converged ? "" : ", NOT CONVERGED");
-    if (!r.converged)
-      throw NumericalError("stretch at F = " + std::to_string(f_pN) + " pN did not reach equilibrium in " +
-                           std::to_string(r.steps) + " FIRE steps (largest node force " +
-                           std::to_string(r.max_force) + " N)");
+    std::fflush(stdout);
+    if (!r.converged) {
+      csv.close();  // keep the forces that did converge
+      std::rename((out + "/series.csv.tmp").c_str(), (out + "/series.csv").c_str());
+      char msg[256];
+      std::snprintf(msg, sizeof msg,
+                    "stretch at F = %g pN did not reach equilibrium in %d FIRE steps (largest node force %.3g N); "
+                    "series.csv holds the forces before it",
+                    f_pN, r.steps, r.max_force);
+      throw NumericalError(msg);
+    }
   }
   csv.close();
   std::rename((out + "/series.csv.tmp").c_str(), (out + "/series.csv").c_str());
