@@ -73,12 +73,12 @@ void update_rigid_modes(const ExecutionSpace& space, const MeshBuffers<MemorySpa
       });
 }
 
-// z = D⁻¹ r + Z (ZᵀΓZ)⁻¹ Zᵀ r (D: Γ's block diagonal, from update_friction).
+// z = Q r (accumulate: z += Q r), Q = Z (ZᵀΓZ)⁻¹ Zᵀ the exact solve on the rigid modes.
 template <class ExecutionSpace, class MemorySpace>
-void apply_rigid_two_level(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                           const FrictionOperator<MemorySpace>& op, const RigidModes<MemorySpace>& rm,
-                           const typename FrictionOperator<MemorySpace>::Vector& r,
-                           const typename FrictionOperator<MemorySpace>::Vector& z) {
+void apply_rigid_coarse(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                        const RigidModes<MemorySpace>& rm,
+                        const typename FrictionOperator<MemorySpace>::Vector& r,
+                        const typename FrictionOperator<MemorySpace>::Vector& z, bool accumulate) {
   using Policy = Kokkos::TeamPolicy<ExecutionSpace>;
   using Member = typename Policy::member_type;
   const auto x = mesh.x;
@@ -115,7 +115,6 @@ void apply_rigid_two_level(const ExecutionSpace& space, const MeshBuffers<Memory
           coarse(c, 5) = w.z;
         });
       });
-  const auto inv = op.block_inverse;
   const auto node_cell = mesh.node_cell;
   Kokkos::parallel_for(
       "dcm::rigid::prolong", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
@@ -123,10 +122,58 @@ void apply_rigid_two_level(const ExecutionSpace& space, const MeshBuffers<Memory
         const int c = node_cell(i);
         const Real3 centre{cell(c, 0), cell(c, 1), cell(c, 2)};
         const Real3 u{coarse(c, 0), coarse(c, 1), coarse(c, 2)}, w{coarse(c, 3), coarse(c, 4), coarse(c, 5)};
-        const Real3 jac =
-            sym3_times(inv(i, 0), inv(i, 1), inv(i, 2), inv(i, 3), inv(i, 4), inv(i, 5), load3(r, i));
-        store3(z, i, jac + u + cross(w, load3(x, i) - centre));
+        const Real3 q = u + cross(w, load3(x, i) - centre);
+        store3(z, i, accumulate ? load3(z, i) + q : q);
       });
+}
+
+// z = D⁻¹ r + Q r (D: Γ's block diagonal, from update_friction): the additive two-level preconditioner.
+template <class ExecutionSpace, class MemorySpace>
+void apply_rigid_two_level(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                           const FrictionOperator<MemorySpace>& op, const RigidModes<MemorySpace>& rm,
+                           const typename FrictionOperator<MemorySpace>::Vector& r,
+                           const typename FrictionOperator<MemorySpace>::Vector& z) {
+  apply_block_jacobi(space, op, r, z);
+  apply_rigid_coarse(space, mesh, rm, r, z, true);
+}
+
+// Balanced (deflated, multiplicative) combination of the rigid-mode solve Q with an inner SPD
+// preconditioner V (block-Jacobi or the multigrid V-cycle):
+//   M⁻¹ = Q + (I − QΓ) V (I − ΓQ)
+// symmetric (Q and Γ are) and positive definite when V is; rigid motions are solved exactly. Costs two
+// applications of Γ more than V alone. inner(in, out) computes out = V in.
+template <class MemorySpace>
+struct DeflationWorkspace {
+  using Vector = typename FrictionOperator<MemorySpace>::Vector;
+  Vector y, t, u;
+  DeflationWorkspace() = default;
+  explicit DeflationWorkspace(int n)
+      : y(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::rigid::y"), n),
+        t(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::rigid::t"), n),
+        u(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::rigid::u"), n) {}
+};
+
+template <class ExecutionSpace, class MemorySpace, class Inner>
+void apply_rigid_deflated(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                          const FrictionOperator<MemorySpace>& op, const RigidModes<MemorySpace>& rm,
+                          Inner&& inner, const DeflationWorkspace<MemorySpace>& w,
+                          const typename FrictionOperator<MemorySpace>::Vector& r,
+                          const typename FrictionOperator<MemorySpace>::Vector& z) {
+  const auto y = w.y, t = w.t, u = w.u;
+  apply_rigid_coarse(space, mesh, rm, r, y, false);  // y = Q r
+  apply_friction(space, mesh, op, y, t);
+  Kokkos::parallel_for(
+      "dcm::rigid::deflate", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
+      KOKKOS_LAMBDA(const int i) { store3(t, i, load3(r, i) - load3(t, i)); });  // t = (I − ΓQ) r
+  inner(t, z);                                                                   // z = V t
+  apply_friction(space, mesh, op, z, u);                                         // u = Γ z
+  Kokkos::parallel_for(
+      "dcm::rigid::combine", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
+      KOKKOS_LAMBDA(const int i) { store3(z, i, load3(z, i) + load3(y, i)); });  // z = Q r + V t
+  apply_rigid_coarse(space, mesh, rm, u, t, false);                              // t = QΓ V t
+  Kokkos::parallel_for(
+      "dcm::rigid::project", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
+      KOKKOS_LAMBDA(const int i) { store3(z, i, load3(z, i) - load3(t, i)); });
 }
 
 }  // namespace dcm
