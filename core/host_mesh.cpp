@@ -27,6 +27,7 @@ HostMesh icosahedron() {
   m.triangles = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
                  {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
                  {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  m.parents.assign(m.nodes.size(), {-1, -1});
   return m;
 }
 
@@ -40,6 +41,7 @@ void subdivide(HostMesh& m) {
     const Vec3& p = m.nodes[a];
     const Vec3& q = m.nodes[b];
     m.nodes.push_back(normalized({p[0] + q[0], p[1] + q[1], p[2] + q[2]}));
+    m.parents.push_back({key.first, key.second});
     const int id = static_cast<int>(m.nodes.size()) - 1;
     midpoint.emplace(key, id);
     return id;

@@ -4,73 +4,15 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <cstdio>
-#include <random>
 
 #include "core/host_copy.hpp"
-#include "solvers/friction_operator.hpp"
 #include "solvers/pcg.hpp"
+#include "tests/friction_setup.hpp"
 
 namespace dcm {
 namespace {
 
-using Exec = Kokkos::DefaultExecutionSpace;
-using Mem = Exec::memory_space;
-using Vector = FrictionOperator<Mem>::Vector;
-constexpr double kPi = 3.14159265358979323846;
-
-// Table 1: η = 0.8 mPa·s, r = 3.25 µm, c = 1.5e-6 N·s/m.
-struct FrictionSetup {
-  MeshBuffers<Mem> mesh;
-  FrictionOperator<Mem> op;
-  explicit FrictionSetup(int k, double c = 1.5e-6, unsigned seed = 7) {
-    HostMesh m = make_icosphere(k, 3.25e-6);
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> u(-0.05e-6, 0.05e-6);
-    for (auto& x : m.nodes)
-      for (double& v : x) v += u(rng);
-    mesh = upload_cells<Mem>({HostCell(m)});
-    Kokkos::View<double*, Kokkos::LayoutRight, Mem> drag("drag", mesh.n_nodes);
-    Kokkos::deep_copy(drag, 6 * kPi * 0.8e-3 * 3.25e-6 / mesh.n_nodes);
-    op = FrictionOperator<Mem>(mesh, drag, c);
-    update_friction(Exec(), mesh, op);
-  }
-  Vector random_vector(unsigned seed, double scale = 1.0) const {
-    Vector v("v", mesh.n_nodes);
-    auto h = Kokkos::create_mirror_view(v);
-    std::mt19937 rng(seed);
-    std::normal_distribution<double> g(0, scale);
-    for (int i = 0; i < mesh.n_nodes; ++i)
-      for (int d = 0; d < 3; ++d) h(i, d) = g(rng);
-    Kokkos::deep_copy(v, h);
-    return v;
-  }
-  Vector apply(const Vector& v) const {
-    Vector out("out", mesh.n_nodes);
-    apply_friction(Exec(), mesh, op, v, out);
-    return out;
-  }
-  // Γ assembled on the host from its definition (independent of the kernels): drag on the diagonal,
-  // c n̂n̂ᵀ blocks coupling the two nodes of every bond.
-  Eigen::MatrixXd assemble() const {
-    const int n = mesh.n_nodes;
-    const auto x = to_host_vector(mesh.x);
-    const auto bonds = to_host_vector(mesh.bond);
-    const auto drag = to_host_vector(op.node_drag);
-    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(3 * n, 3 * n);
-    for (int i = 0; i < n; ++i) a.block<3, 3>(3 * i, 3 * i) += drag[i] * Eigen::Matrix3d::Identity();
-    for (std::size_t b = 0; b < bonds.size() / 2; ++b) {
-      const int i = bonds[2 * b], j = bonds[2 * b + 1];
-      const Eigen::Vector3d d = Eigen::Vector3d(x[3 * j], x[3 * j + 1], x[3 * j + 2]) -
-                                Eigen::Vector3d(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
-      const Eigen::Matrix3d nn = op.dashpot * d.normalized() * d.normalized().transpose();
-      a.block<3, 3>(3 * i, 3 * i) += nn;
-      a.block<3, 3>(3 * j, 3 * j) += nn;
-      a.block<3, 3>(3 * i, 3 * j) -= nn;
-      a.block<3, 3>(3 * j, 3 * i) -= nn;
-    }
-    return a;
-  }
-};
+using namespace test_friction;
 
 double dot_host(const std::vector<double>& a, const std::vector<double>& b) {
   double s = 0;

@@ -1,0 +1,80 @@
+#pragma once
+// Block-sparse symmetric matrices with symmetric 3×3 blocks (CSR over nodes), for the assembled coarse
+// levels of the multigrid preconditioner (solvers/multigrid.hpp): y = A x, r = b − A x, the inverted
+// diagonal blocks and a damped block-Jacobi update. Blocks are packed xx, yy, zz, xy, xz, yz like
+// FrictionOperator::block_inverse. Every block of Γ (ζ I and c n̂n̂ᵀ) is symmetric, and so is every
+// Galerkin product of them with the scalar prolongation P ⊗ I₃.
+#include "core/vec3.hpp"
+#include "solvers/friction_operator.hpp"
+
+namespace dcm {
+
+template <class MemorySpace>
+struct BlockCsr {
+  template <class T>
+  using View = Kokkos::View<T, Kokkos::LayoutRight, MemorySpace>;
+  int n_rows = 0, nnz = 0;
+  View<int*> row_offsets;  // n_rows + 1
+  View<int*> cols;         // nnz, sorted within a row
+  View<int*> diag_slot;    // n_rows: the slot of (i, i)
+  View<double* [6]> values;
+  View<double* [6]> diag_inverse;  // inverse of each diagonal block, for the smoother
+};
+
+KOKKOS_INLINE_FUNCTION Real3 sym3_times(const double a0, const double a1, const double a2, const double a3,
+                                        const double a4, const double a5, const Real3 v) {
+  return {a0 * v.x + a3 * v.y + a4 * v.z, a3 * v.x + a1 * v.y + a5 * v.z, a4 * v.x + a5 * v.y + a2 * v.z};
+}
+
+// out = b − A x, the residual; one gather per row.
+template <class ExecutionSpace, class MemorySpace, class Vector>
+void block_csr_residual(const ExecutionSpace& space, const BlockCsr<MemorySpace>& a, const Vector& b,
+                        const Vector& x, const Vector& out) {
+  const auto off = a.row_offsets;
+  const auto cols = a.cols;
+  const auto val = a.values;
+  Kokkos::parallel_for(
+      "dcm::bsr::residual", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows),
+      KOKKOS_LAMBDA(const int i) {
+        Real3 acc = load3(b, i);
+        for (int s = off(i); s < off(i + 1); ++s) {
+          const Real3 y =
+              sym3_times(val(s, 0), val(s, 1), val(s, 2), val(s, 3), val(s, 4), val(s, 5), load3(x, cols(s)));
+          acc = acc - y;
+        }
+        store3(out, i, acc);
+      });
+}
+
+// Inverts every diagonal block (the block-Jacobi smoother's D⁻¹).
+template <class ExecutionSpace, class MemorySpace>
+void block_csr_invert_diagonal(const ExecutionSpace& space, const BlockCsr<MemorySpace>& a) {
+  const auto diag = a.diag_slot;
+  const auto val = a.values;
+  const auto inv = a.diag_inverse;
+  Kokkos::parallel_for(
+      "dcm::bsr::invert_diagonal", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows),
+      KOKKOS_LAMBDA(const int i) {
+        const int s = diag(i);
+        const double blk[6] = {val(s, 0), val(s, 1), val(s, 2), val(s, 3), val(s, 4), val(s, 5)};
+        double out[6];
+        invert_sym3(blk, out);
+        for (int k = 0; k < 6; ++k) inv(i, k) = out[k];
+      });
+}
+
+// x = (accumulate ? x : 0) + ω D⁻¹ r: one damped block-Jacobi step given the residual r.
+template <class ExecutionSpace, class MemorySpace, class Vector>
+void block_jacobi_step(const ExecutionSpace& space, const BlockCsr<MemorySpace>& a, double omega,
+                       bool accumulate, const Vector& r, const Vector& x) {
+  const auto inv = a.diag_inverse;
+  Kokkos::parallel_for(
+      "dcm::bsr::jacobi_step", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows),
+      KOKKOS_LAMBDA(const int i) {
+        const Real3 dz =
+            omega * sym3_times(inv(i, 0), inv(i, 1), inv(i, 2), inv(i, 3), inv(i, 4), inv(i, 5), load3(r, i));
+        store3(x, i, accumulate ? load3(x, i) + dz : dz);
+      });
+}
+
+}  // namespace dcm
