@@ -20,7 +20,7 @@
 #include "core/host_copy.hpp"
 #include "core/json_writer.hpp"
 #include "core/kokkos_compat.hpp"
-#include "solvers/fire_minimizer.hpp"
+#include "solvers/newton_equilibrium.hpp"
 
 namespace dcm {
 namespace {
@@ -62,7 +62,7 @@ void run(const AppOptions& options, const StretchOptions& so) {
     h5.write_mesh(x0.data(), n, tri.data(), static_cast<int>(mesh.triangles.size()), node_cell.data());
   }
   std::ofstream csv(out + "/series.csv.tmp");
-  csv << "F_N,DA_m,DT_m,fire_steps,max_residual_force_N\n";
+  csv << "F_N,DA_m,DT_m,newton_steps,max_residual_force_N\n";
   std::vector<double> forces, da, dt;
   auto ext = Kokkos::create_mirror_view(model.external_force());
   for (double f_pN : so.forces_pN) {
@@ -71,24 +71,24 @@ void run(const AppOptions& options, const StretchOptions& so) {
     for (int i : left) ext(i, 0) = -f / left.size();
     for (int i : right) ext(i, 0) = f / right.size();
     Kokkos::deep_copy(model.external_force(), ext);
-    FireSettings fs;
-    fs.force_tol = std::max(1e-4 * 200e-12 / left.size(), 1e-17);
-    if (const char* trace = std::getenv("DCM_FIRE_TRACE")) fs.trace_every = std::atoi(trace);
-    const FireResult r = fire_minimize(model, fs, edge);
+    NewtonSettings ns;
+    ns.force_tol = std::max(1e-4 * 200e-12 / left.size(), 1e-17);
+    if (const char* trace = std::getenv("DCM_NEWTON_TRACE")) ns.trace = std::atoi(trace);
+    const NewtonResult r = newton_equilibrium(model, ns, edge);
     const auto x = to_host_vector(model.positions());
     const auto [d_axial, d_transverse] = axial_transverse_diameters(x);
     forces.push_back(f);
     da.push_back(d_axial);
     dt.push_back(d_transverse);
     char line[256];
-    std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%d,%.6g\n", f, da.back(), dt.back(), r.steps,
+    std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%d,%.6g\n", f, da.back(), dt.back(), r.newton_steps,
                   r.max_force);
     csv << line;
     const auto ext_h = to_host_vector(model.external_force());
     h5.write_frame(f, x.data(), {{"external_force_N", 3, ext_h.data()}});
     if (!options.quiet)
-      std::printf("  F = %7.2f pN   D_A = %6.3f um   D_T = %6.3f um   (%d FIRE steps, residual %.2g N%s)\n",
-                  f_pN, da.back() * 1e6, dt.back() * 1e6, r.steps, r.max_force,
+      std::printf("  F = %7.2f pN   D_A = %6.3f um   D_T = %6.3f um   (%d Newton steps, residual %.2g N%s)\n",
+                  f_pN, da.back() * 1e6, dt.back() * 1e6, r.newton_steps, r.max_force,
                   r.converged ? "" : ", NOT CONVERGED");
     std::fflush(stdout);
     if (!r.converged) {
@@ -96,9 +96,9 @@ void run(const AppOptions& options, const StretchOptions& so) {
       std::rename((out + "/series.csv.tmp").c_str(), (out + "/series.csv").c_str());
       char msg[256];
       std::snprintf(msg, sizeof msg,
-                    "stretch at F = %g pN did not reach equilibrium in %d FIRE steps (largest node force %.3g N); "
+                    "stretch at F = %g pN did not reach equilibrium in %d Newton steps (largest node force %.3g N); "
                     "series.csv holds the forces before it",
-                    f_pN, r.steps, r.max_force);
+                    f_pN, r.newton_steps, r.max_force);
       throw NumericalError(msg);
     }
   }
