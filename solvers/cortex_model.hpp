@@ -24,6 +24,7 @@
 #include "kernels/fene_pow_bonds.hpp"
 #include "kernels/volume_constraint.hpp"
 #include "solvers/friction_operator.hpp"
+#include "solvers/global_stiffness.hpp"
 #include "solvers/pcg.hpp"
 
 namespace dcm {
@@ -78,6 +79,8 @@ class CortexModel {
     if (p.k_b > 0) hinges_ = make_hinge_rest(space_, mesh_);
     if (p.k_area_local > 0 || p.k_area_global > 0) area_ = make_area_rest(space_, mesh_, geo_);
     if (p.k_volume > 0) volume_ = make_volume_rest(space_, mesh_, geo_);
+    if (p.k_area_global > 0 || p.k_volume > 0)
+      global_ = GlobalStiffness<Mem>(mesh_, p.k_area_global > 0, p.k_volume > 0);
     friction_ = FrictionOperator<Mem>(mesh_, node_drag(cells), p.dashpot);
   }
 
@@ -124,11 +127,18 @@ class CortexModel {
     return e;
   }
 
-  // Γ v = F for the current positions and forces (compute_forces() first). Without dashpots Γ is diagonal
-  // and the solve is one division per node.
-  CgResult solve_velocity(const CgSettings& settings) {
+  // Γ v = F for the current positions and forces (compute_forces() first), warm-started from the last v.
+  // With dt > 0 the global area and volume constraints are taken linearly implicit, (Γ + dt K_global) v = F
+  // (solvers/global_stiffness.hpp); dt = 0 solves Γ v = F. Without dashpots and implicit terms Γ is
+  // diagonal and the solve is one multiplication per node.
+  CgResult solve_velocity(const CgSettings& settings, double dt = 0) {
     update_friction(space_, mesh_, friction_);
-    if (params_.dashpot == 0) {
+    const bool implicit = dt > 0 && global_.has_value();
+    if (implicit)
+      update_global_stiffness(space_, mesh_, geo_, area_ ? area_->cell_area : volume_->cell_volume,
+                              volume_ ? volume_->cell_volume : area_->cell_area, params_.k_area_global,
+                              params_.k_volume, dt, *global_);
+    if (params_.dashpot == 0 && !implicit) {
       apply_block_jacobi(space_, friction_, force_, velocity_);
       CgResult r;
       r.converged = true;
@@ -136,7 +146,10 @@ class CortexModel {
     }
     const CgResult r = pcg_solve(
         space_,
-        [&](const Vector& in, const Vector& out) { apply_friction(space_, mesh_, friction_, in, out); },
+        [&](const Vector& in, const Vector& out) {
+          apply_friction(space_, mesh_, friction_, in, out);
+          if (implicit) apply_global_stiffness(space_, mesh_, *global_, in, out);
+        },
         [&](const Vector& in, const Vector& out) { apply_block_jacobi(space_, friction_, in, out); }, force_,
         velocity_, cg_, settings);
     if (!r.converged && !(r.residual_norm < INFINITY))
@@ -145,12 +158,16 @@ class CortexModel {
     if (!r.converged)
       throw NumericalError("conjugate gradients did not converge in " + std::to_string(r.iterations) +
                            " iterations (residual " + std::to_string(r.residual_norm) + " N, tolerance " +
-                           std::to_string(settings.abs_tol) + " N); raise solver.cg_max_iterations");
+                           std::to_string(settings.abs_tol) + " N)");
     const int bad = first_non_finite_node(space_, velocity_);
     if (bad >= 0)
       throw NumericalError("non-finite velocity at node " + std::to_string(bad) + " after the solve");
     return r;
   }
+
+  // F · v: the rate at which the forces do work on the current velocity (W); with the explicit step it
+  // equals the dissipation vᵀΓv, with the implicit global terms it is vᵀ(Γ + dt K)v.
+  double power() { return cg_detail::dot(space_, force_, velocity_); }
 
   // x += dt v (forward Euler, paper eq. 32 integrated explicitly).
   void advance(double dt) {
@@ -236,6 +253,7 @@ class CortexModel {
   std::optional<HingeRest<Mem>> hinges_;
   std::optional<AreaRest<Mem>> area_;
   std::optional<VolumeRest<Mem>> volume_;
+  std::optional<GlobalStiffness<Mem>> global_;
   FrictionOperator<Mem> friction_;
   CgWorkspace<Mem> cg_;
 };

@@ -15,12 +15,12 @@
 namespace dcm {
 
 struct NewtonSettings {
-  double force_tol = 1e-16;   // N
+  double force_tol = 1e-16;  // N
   int max_newton_steps = 200;
   int max_cg_iterations = 3000;
-  double cg_rel_tol = 1e-3;   // inner solve: relative to |F| (inexact Newton)
-  double mu_start = 0;        // N/m; 0: 1e-3 k_s
-  int trace = 0;              // > 0: print every Newton step to stderr
+  double cg_rel_tol = 1e-3;  // inner solve: relative to |F| (inexact Newton)
+  double mu_start = 0;       // N/m; 0: 1e-3 k_s
+  int trace = 0;             // > 0: print every Newton step to stderr
 };
 
 struct NewtonResult {
@@ -30,14 +30,15 @@ struct NewtonResult {
 };
 
 template <class ExecutionSpace>
-NewtonResult newton_equilibrium(CortexModel<ExecutionSpace>& model, const NewtonSettings& s, double length_scale) {
+NewtonResult newton_equilibrium(CortexModel<ExecutionSpace>& model, const NewtonSettings& s,
+                                double length_scale) {
   using Vector = typename CortexModel<ExecutionSpace>::Vector;
   using Policy = Kokkos::RangePolicy<ExecutionSpace>;
   const ExecutionSpace space = model.space();
   const int n = model.mesh().n_nodes;
   const Vector x = model.positions(), f = model.force();
-  Vector f0("dcm::newton::f0", n), x0("dcm::newton::x0", n), delta("dcm::newton::delta", n), r("dcm::newton::r", n),
-      p("dcm::newton::p", n), hp("dcm::newton::hp", n);
+  Vector f0("dcm::newton::f0", n), x0("dcm::newton::x0", n), delta("dcm::newton::delta", n),
+      r("dcm::newton::r", n), p("dcm::newton::p", n), hp("dcm::newton::hp", n);
   NewtonResult result;
 
   auto max_norm = [&](const Vector& v) {
@@ -132,8 +133,9 @@ NewtonResult newton_equilibrium(CortexModel<ExecutionSpace>& model, const Newton
       ++result.force_evaluations;
     }
     if (s.trace > 0 && result.newton_steps % s.trace == 0)
-      std::fprintf(stderr, "  Newton %d: max |F| = %.3e N, E = %.10e J, mu = %.2e, CG %d%s\n", result.newton_steps,
-                   result.max_force, energy, mu, it, trial < INFINITY ? "" : " (overstretched: retry)");
+      std::fprintf(stderr, "  Newton %d: max |F| = %.3e N, E = %.10e J, mu = %.2e, CG %d%s\n",
+                   result.newton_steps, result.max_force, energy, mu, it,
+                   trial < INFINITY ? "" : " (overstretched: retry)");
   }
   return result;
 }

@@ -106,7 +106,7 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
     CgResult r;
     try {
       model.compute_forces();
-      r = model.solve_velocity(cg);
+      r = model.solve_velocity(cg, dt);
     } catch (const NumericalError& e) {
       throw NumericalError("step " + std::to_string(step) + " (t = " + std::to_string(t) +
                            " s): " + e.what());

@@ -95,10 +95,11 @@ void run(const AppOptions& options, const StretchOptions& so) {
       csv.close();  // keep the forces that did converge
       std::rename((out + "/series.csv.tmp").c_str(), (out + "/series.csv").c_str());
       char msg[256];
-      std::snprintf(msg, sizeof msg,
-                    "stretch at F = %g pN did not reach equilibrium in %d Newton steps (largest node force %.3g N); "
-                    "series.csv holds the forces before it",
-                    f_pN, r.newton_steps, r.max_force);
+      std::snprintf(
+          msg, sizeof msg,
+          "stretch at F = %g pN did not reach equilibrium in %d Newton steps (largest node force %.3g N); "
+          "series.csv holds the forces before it",
+          f_pN, r.newton_steps, r.max_force);
       throw NumericalError(msg);
     }
   }
