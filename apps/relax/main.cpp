@@ -18,7 +18,7 @@
 #include "core/host_copy.hpp"
 #include "core/json_writer.hpp"
 #include "core/kokkos_compat.hpp"
-#include "solvers/fire_minimizer.hpp"
+#include "solvers/newton_equilibrium.hpp"
 
 namespace dcm {
 namespace {
@@ -74,9 +74,9 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
   for (int i : left) ext(i, 0) = -ro.hold_force_pN * 1e-12 / left.size();
   for (int i : right) ext(i, 0) = ro.hold_force_pN * 1e-12 / right.size();
   Kokkos::deep_copy(model.external_force(), ext);
-  FireSettings fs;
-  fs.force_tol = 1e-4 * ro.hold_force_pN * 1e-12 / left.size();
-  const FireResult held = fire_minimize(model, fs, mean_edge_length(mesh, build_topology(mesh)));
+  NewtonSettings ns;
+  ns.force_tol = 1e-4 * ro.hold_force_pN * 1e-12 / left.size();
+  const NewtonResult held = newton_equilibrium(model, ns, mean_edge_length(mesh, build_topology(mesh)));
   if (!held.converged)
     throw NumericalError("the stretched cell did not reach equilibrium before the release");
   const auto [da0, dt0] = axial_transverse_diameters(to_host_vector(model.positions()));
