@@ -31,7 +31,7 @@ struct StretchOptions {
   std::vector<double> forces_pN = {0,       15.987,  19.338,  30.754,  38.365,  47.245, 67.964, 87.837,
                                    108.949, 130.513, 150.809, 172.374, 192.688, 200};  // Mills 2004 + 200
   double pulled_fraction = 0.05;
-  bool plot = true;
+  bool no_plot = false;
 };
 
 void run(const AppOptions& options, const StretchOptions& so) {
@@ -131,6 +131,7 @@ int main(int argc, char** argv) {
   dcm::AppOptions options;
   dcm::StretchOptions so;
   dcm::add_common_options(app, options);
+  app.add_flag("--no-plot", so.no_plot, "Do not draw stretch.png");
   app.add_option("--forces-pN", so.forces_pN,
                  "Stretching forces in pN (default: the Mills 2004 forces and 200)")
       ->delimiter(',');
