@@ -99,10 +99,12 @@ std::vector<ParamSpec> make_schema() {
       real_key("cortex.c_N_s_per_m", "1.5e-6", 0, 1, kIncl, "N·s/m", "bond dashpot coefficient"),
       real_key("cortex.k_b_J", "240e-21", 0, 1e-15, kIncl, "J", "bending stiffness"),
       real_key("cortex.k_a", "6e-3", 0, 10, kIncl, "N/m",
-               "local area constraint, E = Σ k_a (A_t − A_t*)²/(2A_t*); Table 1's 6e3 read in µN/m (docs/MODEL.md)"),
+               "local area constraint, E = Σ k_a (A_t − A_t*)²/(2A_t*); Table 1's 6e3 read in µN/m "
+               "(docs/MODEL.md)"),
       real_key("cortex.k_d", "6e-3", 0, 10, kIncl, "N/m",
                "global area constraint, E = k_d (A − A*)²/(2A*); Table 1's 6e3 read in µN/m"),
-      real_key("cortex.k_v", "1e4", 0, 1e9, kIncl, "Pa", "volume constraint, E = k_v (V − V*)²/(2V*); Table 1's 10e3"),
+      real_key("cortex.k_v", "1e4", 0, 1e9, kIncl, "Pa",
+               "volume constraint, E = k_v (V − V*)²/(2V*); Table 1's 10e3"),
 
       real_key("fluid.eta_Pa_s", "0.8e-3", 0, 10, kExcl, "Pa·s", "viscosity of the medium"),
 

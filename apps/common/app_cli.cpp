@@ -39,8 +39,10 @@ void add_common_options(CLI::App& app, AppOptions& o) {
       "Print every scene key with its type, default, unit and allowed range, then exit");
 }
 
-Scene load_scene(const AppOptions& o) {
+Scene load_scene(const AppOptions& o, const std::vector<std::string>& without_file) {
   Scene scene = o.scene_path.empty() ? Scene::defaults() : Scene::from_file(o.scene_path);
+  if (o.scene_path.empty())
+    for (const std::string& s : without_file) scene.set(s);
   for (const std::string& s : o.sets) scene.set(s);
   scene.validate();
   return scene;

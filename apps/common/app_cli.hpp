@@ -25,8 +25,9 @@ struct AppOptions {
 
 void add_common_options(CLI::App& app, AppOptions& options);
 
-// The scene from the file (or defaults), with every --set applied, validated. Throws SceneError.
-Scene load_scene(const AppOptions& options);
+// The scene from the file (or the built-in defaults changed by `without_file`, e.g. an app's own
+// experiment), with every --set applied, validated. Throws SceneError.
+Scene load_scene(const AppOptions& options, const std::vector<std::string>& without_file = {});
 
 // --out, else output.dir, else out/<scene name>. Creates it; throws IoError if it cannot be written.
 std::string prepare_output_dir(const AppOptions& options, const Scene& scene);
