@@ -3,17 +3,16 @@
 // sphere scaled by 1.02, so every bond is stretched and every term does its full work.
 //   build/bin/bench_forces [--benchmark_filter=...]
 // Reported: time per call and ns per node (counter "ns_per_node").
-#include <benchmark/benchmark.h>
-
 #include "core/kokkos_compat.hpp"
 #include "kernels/bending.hpp"
 #include "kernels/fene_pow_bonds.hpp"
+#include "perf/bench_common.hpp"
 
 namespace dcm {
 namespace {
 
-using Exec = Kokkos::DefaultExecutionSpace;
-using Mem = Exec::memory_space;
+using bench::Exec;
+using bench::Mem;
 
 struct Fixture {
   MeshBuffers<Mem> mesh;
@@ -41,16 +40,7 @@ struct Fixture {
 
 template <class Kernel>
 void run(benchmark::State& state, Kernel&& kernel) {
-  Fixture f(static_cast<int>(state.range(0)));
-  const Exec space;
-  for (auto _ : state) {
-    kernel(space, f);
-    space.fence();
-  }
-  state.counters["nodes"] = f.mesh.n_nodes;
-  state.counters["ns_per_node"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) * f.mesh.n_nodes * 1e-9,
-                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  bench::run_per_node<Fixture>(state, kernel);
 }
 
 void fene_pow(benchmark::State& s) {
@@ -74,10 +64,4 @@ BENCHMARK(bending_per_node)->DCM_MESHES;
 }  // namespace
 }  // namespace dcm
 
-int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);
-  dcm::KokkosSession kokkos;
-  benchmark::AddCustomContext("kokkos", dcm::kokkos_description());
-  benchmark::RunSpecifiedBenchmarks();
-  return 0;
-}
+DCM_BENCHMARK_MAIN()

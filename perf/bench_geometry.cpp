@@ -2,16 +2,15 @@
 // on the default execution space (threads: OMP_NUM_THREADS or --kokkos-threads).
 //   build/bin/bench_geometry [--benchmark_filter=...]
 // Reported: time per call and ns per node (counter "ns_per_node").
-#include <benchmark/benchmark.h>
-
 #include "core/kokkos_compat.hpp"
 #include "core/update_geometry.hpp"
+#include "perf/bench_common.hpp"
 
 namespace dcm {
 namespace {
 
-using Exec = Kokkos::DefaultExecutionSpace;
-using Mem = Exec::memory_space;
+using bench::Exec;
+using bench::Mem;
 
 struct Fixture {
   MeshBuffers<Mem> mesh;
@@ -24,16 +23,7 @@ struct Fixture {
 
 template <class Kernel>
 void run(benchmark::State& state, Kernel&& kernel) {
-  Fixture f(static_cast<int>(state.range(0)));
-  const Exec space;
-  for (auto _ : state) {
-    kernel(space, f);
-    space.fence();
-  }
-  state.counters["nodes"] = f.mesh.n_nodes;
-  state.counters["ns_per_node"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) * f.mesh.n_nodes * 1e-9,
-                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  bench::run_per_node<Fixture>(state, kernel);
 }
 
 void update_all(benchmark::State& s) {
@@ -66,10 +56,4 @@ BENCHMARK(rounded_triangles)->DCM_MESHES;
 }  // namespace
 }  // namespace dcm
 
-int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);
-  dcm::KokkosSession kokkos;
-  benchmark::AddCustomContext("kokkos", dcm::kokkos_description());
-  benchmark::RunSpecifiedBenchmarks();
-  return 0;
-}
+DCM_BENCHMARK_MAIN()

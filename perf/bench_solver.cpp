@@ -3,11 +3,10 @@
 // relative, with each preconditioner; and the per-step set-up of each.
 //   build/bin/bench_solver [--benchmark_filter=...]
 // Counters: iterations (PCG), nodes. Time per solve is the benchmark's own time.
-#include <benchmark/benchmark.h>
-
 #include <random>
 
 #include "core/kokkos_compat.hpp"
+#include "perf/bench_common.hpp"
 #include "solvers/multigrid.hpp"
 #include "solvers/pcg.hpp"
 #include "solvers/rigid_modes.hpp"
@@ -15,8 +14,8 @@
 namespace dcm {
 namespace {
 
-using Exec = Kokkos::DefaultExecutionSpace;
-using Mem = Exec::memory_space;
+using bench::Exec;
+using bench::Mem;
 using Vector = FrictionOperator<Mem>::Vector;
 
 struct Fixture {
@@ -134,10 +133,4 @@ BENCHMARK(setup_multigrid)->DCM_MESHES;
 }  // namespace
 }  // namespace dcm
 
-int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);
-  dcm::KokkosSession kokkos;
-  benchmark::AddCustomContext("kokkos", dcm::kokkos_description());
-  benchmark::RunSpecifiedBenchmarks();
-  return 0;
-}
+DCM_BENCHMARK_MAIN()
