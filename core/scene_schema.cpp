@@ -117,6 +117,17 @@ std::vector<ParamSpec> make_schema() {
       real_key("time.dt_s", "6e-6", 0, 1, kExcl, "s", "time step"),
       real_key("time.t_end_s", "1.2", 0, 1e6, kIncl, "s", "simulated time"),
 
+      real_key("solver.cg_abs_tol_N", "1e-14", 0, 1e-6, kIncl, "N",
+               "CG stops when the force residual ||F − Γv||₂ is below this (the paper's 1e-14 N) ..."),
+      real_key("solver.cg_rel_tol", "0", 0, 0.1, kIncl, "",
+               "... or below this fraction of ||F||₂ (the looser of the two wins)"),
+      int_key("solver.cg_max_iterations", "20000", 1, 1e7,
+              "CG iterations before a step fails with exit code 3"),
+      string_key(
+          "solver.preconditioner", "multigrid", {"block_jacobi", "multigrid"},
+          "preconditioner of Γ: multigrid (V-cycle on the icosphere hierarchy; block_jacobi where a mesh "
+          "has none) or block_jacobi"),
+
       string_key("output.dir", "", {}, "output directory (empty: out/<name>)"),
       bool_key("output.hdf5", "true", "write the HDF5 + XDMF output"),
   };

@@ -10,6 +10,7 @@
 // Numerical trouble (a FENE bond at d_max, a non-finite force or velocity) throws NumericalError naming
 // the term and the node or bond; callers add the step.
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -25,6 +26,7 @@
 #include "kernels/volume_constraint.hpp"
 #include "solvers/friction_operator.hpp"
 #include "solvers/global_stiffness.hpp"
+#include "solvers/multigrid.hpp"
 #include "solvers/pcg.hpp"
 
 namespace dcm {
@@ -40,6 +42,7 @@ struct MechanicsParams {
   double dashpot = 0;         // c (N·s/m)
   double viscosity = 0.8e-3;  // η (Pa·s), Stokes drag 6πηr/N per node
   double h_min = 1e4;         // 1/m, triangle curvature clamp
+  bool multigrid = false;     // V-cycle preconditioner (where the mesh has an icosphere hierarchy)
 };
 
 // Index of the first node with a non-finite component, or -1.
@@ -82,6 +85,10 @@ class CortexModel {
     if (p.k_area_global > 0 || p.k_volume > 0)
       global_ = GlobalStiffness<Mem>(mesh_, p.k_area_global > 0, p.k_volume > 0);
     friction_ = FrictionOperator<Mem>(mesh_, node_drag(cells), p.dashpot);
+    if (p.multigrid && p.dashpot > 0) {
+      multigrid_ = make_multigrid(cells, mesh_);
+      if (!multigrid_->available) multigrid_.reset();  // no hierarchy: block-Jacobi
+    }
   }
 
   const MeshBuffers<Mem>& mesh() const { return mesh_; }
@@ -133,6 +140,7 @@ class CortexModel {
   // diagonal and the solve is one multiplication per node.
   CgResult solve_velocity(const CgSettings& settings, double dt = 0) {
     update_friction(space_, mesh_, friction_);
+    if (multigrid_) update_multigrid(space_, mesh_, friction_, *multigrid_);
     const bool implicit = dt > 0 && global_.has_value();
     if (implicit)
       update_global_stiffness(space_, mesh_, geo_, area_ ? area_->cell_area : volume_->cell_volume,
@@ -150,15 +158,27 @@ class CortexModel {
           apply_friction(space_, mesh_, friction_, in, out);
           if (implicit) apply_global_stiffness(space_, mesh_, *global_, in, out);
         },
-        [&](const Vector& in, const Vector& out) { apply_block_jacobi(space_, friction_, in, out); }, force_,
-        velocity_, cg_, settings);
+        [&](const Vector& in, const Vector& out) {
+          if (multigrid_)
+            apply_multigrid(space_, *multigrid_, in, out);
+          else
+            apply_block_jacobi(space_, friction_, in, out);
+        },
+        force_, velocity_, cg_, settings);
     if (!r.converged && !(r.residual_norm < INFINITY))
       throw NumericalError("conjugate gradients diverged (residual " + std::to_string(r.residual_norm) +
                            " N)");
-    if (!r.converged)
-      throw NumericalError("conjugate gradients did not converge in " + std::to_string(r.iterations) +
-                           " iterations (residual " + std::to_string(r.residual_norm) + " N, tolerance " +
-                           std::to_string(settings.abs_tol) + " N)");
+    if (!r.converged) {
+      char msg[200];
+      std::snprintf(
+          msg, sizeof msg,
+          "conjugate gradients did not converge in %d iterations (residual %.3g N, tolerance %.3g N); "
+          "raise solver.cg_max_iterations or solver.cg_rel_tol",
+          r.iterations, r.residual_norm,
+          settings.abs_tol > settings.rel_tol * r.rhs_norm ? settings.abs_tol
+                                                           : settings.rel_tol * r.rhs_norm);
+      throw NumericalError(msg);
+    }
     const int bad = first_non_finite_node(space_, velocity_);
     if (bad >= 0)
       throw NumericalError("non-finite velocity at node " + std::to_string(bad) + " after the solve");
@@ -254,6 +274,7 @@ class CortexModel {
   std::optional<AreaRest<Mem>> area_;
   std::optional<VolumeRest<Mem>> volume_;
   std::optional<GlobalStiffness<Mem>> global_;
+  std::optional<Multigrid<Mem>> multigrid_;
   FrictionOperator<Mem> friction_;
   CgWorkspace<Mem> cg_;
 };

@@ -33,7 +33,16 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
   p.dashpot = scene.get_real("cortex.c_N_s_per_m");
   p.viscosity = scene.get_real("fluid.eta_Pa_s");
   p.h_min = scene.get_real("geometry.h_min_per_m");
+  p.multigrid = scene.get_string("solver.preconditioner") == "multigrid";
   return p;
+}
+
+inline CgSettings cg_settings_from_scene(const Scene& scene) {
+  CgSettings s;
+  s.abs_tol = scene.get_real("solver.cg_abs_tol_N");
+  s.rel_tol = scene.get_real("solver.cg_rel_tol");
+  s.max_iterations = static_cast<int>(scene.get_int("solver.cg_max_iterations"));
+  return s;
 }
 
 }  // namespace dcm

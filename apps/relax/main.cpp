@@ -89,7 +89,7 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
   Kokkos::deep_copy(model.external_force(), 0.0);
   const double dt = scene.get_real("time.dt_s");
   const long long steps = std::llround(ro.duration_s / dt);
-  CgSettings cg;  // the paper's absolute force residual
+  const CgSettings cg = cg_settings_from_scene(scene);
   std::vector<int> tri, node_cell(n, 0);
   for (const Tri& t : mesh.triangles) tri.insert(tri.end(), t.begin(), t.end());
   H5Output h5(out + "/relax.h5");
