@@ -97,6 +97,10 @@ std::vector<ParamSpec> make_schema() {
       real_key("cortex.k_s_N_per_m", "3.2e-6", 0, 1, kExcl, "N/m", "FENE+POW spring constant"),
       real_key("cortex.x_max", "2.05", 1, 10, kExcl, "", "maximum bond extension d_max/d*"),
       real_key("cortex.c_N_s_per_m", "1.5e-6", 0, 1, kIncl, "N·s/m", "bond dashpot coefficient"),
+      string_key(
+          "cortex.dashpot", "axial", {"axial", "relative"},
+          "axial: c damps the bond-length rate only (eq. 25); relative: c damps the whole relative velocity "
+          "c (v_i − v_j), as eq. 32 writes it (also damps bending and rigid rotation)"),
       real_key("cortex.k_b_J", "240e-21", 0, 1e-15, kIncl, "J", "bending stiffness"),
       real_key("cortex.k_a", "6e-3", 0, 10, kIncl, "N/m",
                "local area constraint, E = Σ k_a (A_t − A_t*)²/(2A_t*); Table 1's 6e3 read in µN/m "

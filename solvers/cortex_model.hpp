@@ -34,15 +34,16 @@ namespace dcm {
 // Constants in the units of the energies of docs/model/ (SI). See mechanics_from_scene() for how the
 // paper's Table 1 numbers map onto them.
 struct MechanicsParams {
-  FenePowParams bonds;        // k_s (N/m), x_max
-  double k_b = 0;             // J, bending
-  double k_area_local = 0;    // N/m, E = Σ k (A_t − A_t*)² / (2 A_t*)
-  double k_area_global = 0;   // N/m, E = k (A − A*)² / (2 A*)
-  double k_volume = 0;        // Pa,  E = k (V − V*)² / (2 V*)
-  double dashpot = 0;         // c (N·s/m)
-  double viscosity = 0.8e-3;  // η (Pa·s), Stokes drag 6πηr/N per node
-  double h_min = 1e4;         // 1/m, triangle curvature clamp
-  bool multigrid = false;     // V-cycle preconditioner (where the mesh has an icosphere hierarchy)
+  FenePowParams bonds;            // k_s (N/m), x_max
+  double k_b = 0;                 // J, bending
+  double k_area_local = 0;        // N/m, E = Σ k (A_t − A_t*)² / (2 A_t*)
+  double k_area_global = 0;       // N/m, E = k (A − A*)² / (2 A*)
+  double k_volume = 0;            // Pa,  E = k (V − V*)² / (2 V*)
+  double dashpot = 0;             // c (N·s/m), along each bond (eq. 25)
+  double dashpot_transverse = 0;  // c_t (N·s/m), across each bond (c_t = c: eq. 32's c (v_i − v_j))
+  double viscosity = 0.8e-3;      // η (Pa·s), Stokes drag 6πηr/N per node
+  double h_min = 1e4;             // 1/m, triangle curvature clamp
+  bool multigrid = false;         // V-cycle preconditioner (where the mesh has an icosphere hierarchy)
 };
 
 // Index of the first node with a non-finite component, or -1.
@@ -84,8 +85,8 @@ class CortexModel {
     if (p.k_volume > 0) volume_ = make_volume_rest(space_, mesh_, geo_);
     if (p.k_area_global > 0 || p.k_volume > 0)
       global_ = GlobalStiffness<Mem>(mesh_, p.k_area_global > 0, p.k_volume > 0);
-    friction_ = FrictionOperator<Mem>(mesh_, node_drag(cells), p.dashpot);
-    if (p.multigrid && p.dashpot > 0) {
+    friction_ = FrictionOperator<Mem>(mesh_, node_drag(cells), p.dashpot, p.dashpot_transverse);
+    if (p.multigrid && (p.dashpot > 0 || p.dashpot_transverse > 0)) {
       multigrid_ = make_multigrid(cells, mesh_);
       if (!multigrid_->available) multigrid_.reset();  // no hierarchy: block-Jacobi
     }
@@ -146,7 +147,7 @@ class CortexModel {
       update_global_stiffness(space_, mesh_, geo_, area_ ? area_->cell_area : volume_->cell_volume,
                               volume_ ? volume_->cell_volume : area_->cell_area, params_.k_area_global,
                               params_.k_volume, dt, *global_);
-    if (params_.dashpot == 0 && !implicit) {
+    if (params_.dashpot == 0 && params_.dashpot_transverse == 0 && !implicit) {
       apply_block_jacobi(space_, friction_, force_, velocity_);
       CgResult r;
       r.converged = true;

@@ -4,7 +4,10 @@
 //   (Γ v)_i = ζ_i v_i + Σ_{bonds b = (i, j)} c (n̂_b · (v_i − v_j)) n̂_b        (+ contact blocks, later)
 // ζ_i = 6 π η r_cell / N_cell is the liquid (Stokes) drag spread over the cell's nodes (isotropic),
 // c the Kelvin–Voigt dashpot coefficient of every bond (eq. 25), n̂_b the unit bond direction.
-// Γ is symmetric positive definite: the drag part is ζ I with ζ > 0, each dashpot adds c (Bv)ᵀ(Bv) ≥ 0.
+// Optionally a transverse part c_t (I − n̂n̂ᵀ) per bond: c_t = c makes the bond friction c (v_i − v_j), the
+// form written in the paper's eq. 32 (it damps out-of-plane and shear relative motion, which eq. 25 does
+// not, but also rigid rotations). Each bond block M_b = c n̂n̂ᵀ + c_t (I − n̂n̂ᵀ) is positive semi-definite,
+// so Γ = ζ I + Σ_b [M_b −M_b; −M_b M_b] is symmetric positive definite.
 //
 // Coefficients (n̂_b and each node's 3×3 diagonal block, inverted for the block-Jacobi preconditioner)
 // are cached once per step by update(); apply() is a gather over each node's bonds (no atomics).
@@ -22,14 +25,16 @@ struct FrictionOperator {
   using Vector = View<double* [3]>;
 
   View<double*> node_drag;          // ζ_i (N·s/m)
-  double dashpot = 0;               // c (N·s/m); 0: Γ is diagonal
+  double dashpot = 0;               // c (N·s/m), along the bond (eq. 25)
+  double dashpot_transverse = 0;    // c_t (N·s/m), across the bond; c = c_t = 0: Γ is diagonal
   View<double* [3]> bond_dir;       // n̂_b, cached per step
   View<double* [6]> block_inverse;  // inverse of each node's 3×3 diagonal block: xx, yy, zz, xy, xz, yz
 
   FrictionOperator() = default;
-  FrictionOperator(const MeshBuffers<MemorySpace>& mesh, View<double*> drag, double c)
+  FrictionOperator(const MeshBuffers<MemorySpace>& mesh, View<double*> drag, double c, double c_t = 0)
       : node_drag(drag),
         dashpot(c),
+        dashpot_transverse(c_t),
         bond_dir(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::friction::bond_dir"), mesh.n_bonds),
         block_inverse(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::friction::block_inverse"),
                       mesh.n_nodes) {}
@@ -47,6 +52,17 @@ KOKKOS_INLINE_FUNCTION void invert_sym3(const double a[6], double out[6]) {
   out[3] = c01 * inv;
   out[4] = c02 * inv;
   out[5] = (a[3] * a[4] - a[0] * a[5]) * inv;
+}
+
+// blk += sign · (c n̂n̂ᵀ + c_t (I − n̂n̂ᵀ)), packed xx, yy, zz, xy, xz, yz.
+KOKKOS_INLINE_FUNCTION void add_dashpot_block(Real3 n, double c, double c_t, double sign, double blk[6]) {
+  const double a = sign * (c - c_t), d = sign * c_t;
+  blk[0] += a * n.x * n.x + d;
+  blk[1] += a * n.y * n.y + d;
+  blk[2] += a * n.z * n.z + d;
+  blk[3] += a * n.x * n.y;
+  blk[4] += a * n.x * n.z;
+  blk[5] += a * n.y * n.z;
 }
 
 // Caches n̂_b and the inverted diagonal blocks ζ_i I + Σ_b c n̂_b n̂_bᵀ for the current positions.
@@ -67,20 +83,13 @@ void update_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>
   const auto bonds = mesh.node_bonds;
   const auto drag = op.node_drag;
   const auto inverse = op.block_inverse;
-  const double c = op.dashpot;
+  const double c = op.dashpot, c_t = op.dashpot_transverse;
   Kokkos::parallel_for(
       "dcm::friction::block_jacobi", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
         double a[6] = {drag(i), drag(i), drag(i), 0, 0, 0};
-        for (int s = offsets(i); s < offsets(i + 1); ++s) {
-          const Real3 n = load3(dir, bonds(s));
-          a[0] += c * n.x * n.x;
-          a[1] += c * n.y * n.y;
-          a[2] += c * n.z * n.z;
-          a[3] += c * n.x * n.y;
-          a[4] += c * n.x * n.z;
-          a[5] += c * n.y * n.z;
-        }
+        for (int s = offsets(i); s < offsets(i + 1); ++s)
+          add_dashpot_block(load3(dir, bonds(s)), c, c_t, 1.0, a);
         double inv[6];
         invert_sym3(a, inv);
         for (int k = 0; k < 6; ++k) inverse(i, k) = inv[k];
@@ -98,7 +107,7 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
   const auto bonds = mesh.node_bonds;
   const auto dir = op.bond_dir;
   const auto drag = op.node_drag;
-  const double c = op.dashpot;
+  const double c = op.dashpot, c_t = op.dashpot_transverse;
   Kokkos::parallel_for(
       "dcm::friction::apply", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
@@ -107,8 +116,10 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
         for (int s = offsets(i); s < offsets(i + 1); ++s) {
           const int b = bonds(s);
           const int j = bond(b, 0) == i ? bond(b, 1) : bond(b, 0);
-          const Real3 n = load3(dir, b);
-          acc += (c * dot(n, vi - load3(v, j))) * n;  // eq. 25: dashpot along the bond
+          const Real3 n = load3(dir, b), dv = vi - load3(v, j);
+          const double along = dot(n, dv);
+          acc += (c * along) * n;                       // eq. 25: dashpot along the bond
+          if (c_t != 0) acc += c_t * (dv - along * n);  // optional transverse part (eq. 32's c (v_i − v_j))
         }
         store3(out, i, acc);
       });

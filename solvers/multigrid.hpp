@@ -193,7 +193,7 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
     const auto node_bonds = mesh.node_bonds;
     const auto dir = op.bond_dir;
     const auto drag = op.node_drag;
-    const double c = op.dashpot;
+    const double c = op.dashpot, c_t = op.dashpot_transverse;
     Kokkos::parallel_for(
         "dcm::mg::assemble_fine", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows),
         KOKKOS_LAMBDA(const int i) {
@@ -204,13 +204,7 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
             const double sign = b >= 0 ? -1.0 : 1.0;
             if (b < 0) blk[0] = blk[1] = blk[2] = drag(i);
             for (int t = first; t < last; ++t) {
-              const Real3 n = load3(dir, b >= 0 ? b : node_bonds(t));
-              blk[0] += sign * c * n.x * n.x;
-              blk[1] += sign * c * n.y * n.y;
-              blk[2] += sign * c * n.z * n.z;
-              blk[3] += sign * c * n.x * n.y;
-              blk[4] += sign * c * n.x * n.z;
-              blk[5] += sign * c * n.y * n.z;
+              add_dashpot_block(load3(dir, b >= 0 ? b : node_bonds(t)), c, c_t, sign, blk);
             }
             for (int k = 0; k < 6; ++k) val(s, k) = blk[k];
           }

@@ -76,7 +76,8 @@ struct FrictionSetup {
       const int i = bonds[2 * b], j = bonds[2 * b + 1];
       const Eigen::Vector3d d = Eigen::Vector3d(x[3 * j], x[3 * j + 1], x[3 * j + 2]) -
                                 Eigen::Vector3d(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
-      const Eigen::Matrix3d nn = op.dashpot * d.normalized() * d.normalized().transpose();
+      const Eigen::Matrix3d pp = d.normalized() * d.normalized().transpose();
+      const Eigen::Matrix3d nn = op.dashpot * pp + op.dashpot_transverse * (Eigen::Matrix3d::Identity() - pp);
       a.block<3, 3>(3 * i, 3 * i) += nn;
       a.block<3, 3>(3 * j, 3 * j) += nn;
       a.block<3, 3>(3 * i, 3 * j) -= nn;

@@ -31,6 +31,7 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
   p.k_area_global = scene.get_real("cortex.k_d");
   p.k_volume = scene.get_real("cortex.k_v");
   p.dashpot = scene.get_real("cortex.c_N_s_per_m");
+  p.dashpot_transverse = scene.get_string("cortex.dashpot") == "relative" ? p.dashpot : 0.0;
   p.viscosity = scene.get_real("fluid.eta_Pa_s");
   p.h_min = scene.get_real("geometry.h_min_per_m");
   p.multigrid = scene.get_string("solver.preconditioner") == "multigrid";
