@@ -131,6 +131,9 @@ std::vector<ParamSpec> make_schema() {
           "solver.preconditioner", "multigrid", {"block_jacobi", "multigrid"},
           "preconditioner of Γ: multigrid (V-cycle on the icosphere hierarchy; block_jacobi where a mesh "
           "has none) or block_jacobi"),
+      bool_key(
+          "solver.implicit_bending", "true",
+          "bending's Gauss–Newton stiffness in the velocity solve: stable at the paper's Δt on fine meshes"),
 
       string_key("output.dir", "", {}, "output directory (empty: out/<name>)"),
       bool_key("output.hdf5", "true", "write the HDF5 + XDMF output"),

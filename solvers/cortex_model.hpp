@@ -24,6 +24,7 @@
 #include "kernels/external_forces.hpp"
 #include "kernels/fene_pow_bonds.hpp"
 #include "kernels/volume_constraint.hpp"
+#include "solvers/bending_stiffness.hpp"
 #include "solvers/friction_operator.hpp"
 #include "solvers/global_stiffness.hpp"
 #include "solvers/multigrid.hpp"
@@ -44,6 +45,8 @@ struct MechanicsParams {
   double viscosity = 0.8e-3;      // η (Pa·s), Stokes drag 6πηr/N per node
   double h_min = 1e4;             // 1/m, triangle curvature clamp
   bool multigrid = false;         // V-cycle preconditioner (where the mesh has an icosphere hierarchy)
+  bool implicit_bending =
+      false;  // bending's Gauss-Newton stiffness in the solve (solvers/bending_stiffness.hpp)
 };
 
 // Index of the first node with a non-finite component, or -1.
@@ -81,6 +84,7 @@ class CortexModel {
     update_geometry(space_, mesh_, geo_, p.h_min);
     if (p.bonds.k_s > 0) bonds_ = make_bond_rest(space_, mesh_);
     if (p.k_b > 0) hinges_ = make_hinge_rest(space_, mesh_);
+    if (p.k_b > 0 && p.implicit_bending) bending_stiffness_ = BendingStiffness<Mem>(mesh_);
     if (p.k_area_local > 0 || p.k_area_global > 0) area_ = make_area_rest(space_, mesh_, geo_);
     if (p.k_volume > 0) volume_ = make_volume_rest(space_, mesh_, geo_);
     if (p.k_area_global > 0 || p.k_volume > 0)
@@ -136,18 +140,22 @@ class CortexModel {
   }
 
   // Γ v = F for the current positions and forces (compute_forces() first), warm-started from the last v.
-  // With dt > 0 the global area and volume constraints are taken linearly implicit, (Γ + dt K_global) v = F
-  // (solvers/global_stiffness.hpp); dt = 0 solves Γ v = F. Without dashpots and implicit terms Γ is
+  // With dt > 0 the global area and volume constraints (and bending, if params().implicit_bending) are taken
+  // linearly implicit, (Γ + dt K) v = F (solvers/global_stiffness.hpp, bending_stiffness.hpp); dt = 0 solves
+  // Γ v = F. Without dashpots and implicit terms Γ is
   // diagonal and the solve is one multiplication per node.
   CgResult solve_velocity(const CgSettings& settings, double dt = 0) {
     update_friction(space_, mesh_, friction_);
     if (multigrid_) update_multigrid(space_, mesh_, friction_, *multigrid_);
     const bool implicit = dt > 0 && global_.has_value();
+    const bool implicit_bending = dt > 0 && bending_stiffness_.has_value();
+    if (implicit_bending)
+      update_bending_stiffness(space_, mesh_, *hinges_, params_.k_b, dt, *bending_stiffness_);
     if (implicit)
       update_global_stiffness(space_, mesh_, geo_, area_ ? area_->cell_area : volume_->cell_volume,
                               volume_ ? volume_->cell_volume : area_->cell_area, params_.k_area_global,
                               params_.k_volume, dt, *global_);
-    if (params_.dashpot == 0 && params_.dashpot_transverse == 0 && !implicit) {
+    if (params_.dashpot == 0 && params_.dashpot_transverse == 0 && !implicit && !implicit_bending) {
       apply_block_jacobi(space_, friction_, force_, velocity_);
       CgResult r;
       r.converged = true;
@@ -158,6 +166,7 @@ class CortexModel {
         [&](const Vector& in, const Vector& out) {
           apply_friction(space_, mesh_, friction_, in, out);
           if (implicit) apply_global_stiffness(space_, mesh_, *global_, in, out);
+          if (implicit_bending) apply_bending_stiffness(space_, mesh_, *bending_stiffness_, in, out);
         },
         [&](const Vector& in, const Vector& out) {
           if (multigrid_)
@@ -276,6 +285,7 @@ class CortexModel {
   std::optional<VolumeRest<Mem>> volume_;
   std::optional<GlobalStiffness<Mem>> global_;
   std::optional<Multigrid<Mem>> multigrid_;
+  std::optional<BendingStiffness<Mem>> bending_stiffness_;
   FrictionOperator<Mem> friction_;
   CgWorkspace<Mem> cg_;
 };

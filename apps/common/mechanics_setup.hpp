@@ -35,6 +35,7 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
   p.viscosity = scene.get_real("fluid.eta_Pa_s");
   p.h_min = scene.get_real("geometry.h_min_per_m");
   p.multigrid = scene.get_string("solver.preconditioner") == "multigrid";
+  p.implicit_bending = scene.get_bool("solver.implicit_bending");
   return p;
 }
 
