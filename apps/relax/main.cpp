@@ -130,6 +130,7 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
         if (!options.quiet)
           std::printf("  t = %.4f s  D_A = %.3f um  D_T = %.3f um  CG %d it  (%.0f%%)\n", t, da * 1e6,
                       dtr * 1e6, r.iterations, 100.0 * step / steps);
+        std::fflush(stdout);  // progress must show when the output goes to a file
       }
     }
     model.advance(dt);
