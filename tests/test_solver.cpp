@@ -150,7 +150,8 @@ TEST(FrictionOperator, TransverseDashpotMatchesAssemblyAndDampsRotation) {
   const Vector v = s.random_vector(5);
   const auto vh = to_host_vector(v), gv = to_host_vector(s.apply(v));
   const Eigen::VectorXd expected = a * Eigen::Map<const Eigen::VectorXd>(vh.data(), vh.size());
-  EXPECT_LT((Eigen::Map<const Eigen::VectorXd>(gv.data(), gv.size()) - expected).norm(), 1e-12 * expected.norm());
+  EXPECT_LT((Eigen::Map<const Eigen::VectorXd>(gv.data(), gv.size()) - expected).norm(),
+            1e-12 * expected.norm());
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a, Eigen::EigenvaluesOnly);
   EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0);
   const double relative_power = dot_host(hw, to_host_vector(s.apply(w)));
