@@ -134,6 +134,9 @@ int main(int argc, char** argv) {
   dcm::StretchOptions so;
   dcm::add_common_options(app, options);
   app.add_flag("--no-plot", so.no_plot, "Do not draw stretch.png");
+  app.add_option("--pulled-fraction", so.pulled_fraction,
+                 "Fraction of all nodes pulled at EACH end (the paper: the outermost 5%)")
+      ->check(CLI::Range(0.001, 0.25));
   app.add_option("--forces-pN", so.forces_pN,
                  "Stretching forces in pN (default: the Mills 2004 forces and 200)")
       ->delimiter(',');
