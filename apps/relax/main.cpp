@@ -29,6 +29,7 @@ struct RelaxOptions {
   double hold_force_pN = 13.0;
   double duration_s = 0.6;
   int sample_every = 100;  // steps between samples of the series
+  double pulled_fraction = 0.025;  // per end, as in stretch
 };
 
 // Least-squares slope of log(y) against t over the samples with y > floor; returns −1/slope.
@@ -63,7 +64,7 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
   const auto wall0 = std::chrono::steady_clock::now();
 
   const HostMesh mesh = cell_mesh_from_scene(scene);
-  const auto [left, right] = pulled_nodes(mesh, 0.05);
+  const auto [left, right] = pulled_nodes(mesh, ro.pulled_fraction);
   CortexModel<Exec> model(Exec(), {HostCell(mesh)}, mechanics_from_scene(scene));
   const int n = model.mesh().n_nodes;
   const auto [da_rest, dt_rest] = axial_transverse_diameters(to_host_vector(model.positions()));
@@ -173,6 +174,9 @@ int main(int argc, char** argv) {
   dcm::add_common_options(app, options);
   app.add_option("--hold-force-pN", ro.hold_force_pN, "Force holding the cell before the release (pN)");
   app.add_option("--duration-s", ro.duration_s, "Simulated time after the release (s)");
+  app.add_option("--pulled-fraction", ro.pulled_fraction,
+                 "Fraction of all nodes held at each end (default 0.025: 5% of the nodes in total)")
+      ->check(CLI::Range(0.001, 0.25));
   app.add_option("--sample-every", ro.sample_every, "Steps between rows of series.csv")
       ->check(CLI::Range(1, 1000000));
   return dcm::run_app(app, argc, argv, [&] { dcm::run(options, ro); });
