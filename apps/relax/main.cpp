@@ -28,7 +28,7 @@ using Exec = Kokkos::DefaultExecutionSpace;
 struct RelaxOptions {
   double hold_force_pN = 13.0;
   double duration_s = 0.6;
-  int sample_every = 100;  // steps between samples of the series
+  int sample_every = 100;          // steps between samples of the series
   double pulled_fraction = 0.025;  // per end, as in stretch
 };
 

@@ -134,9 +134,10 @@ int main(int argc, char** argv) {
   dcm::StretchOptions so;
   dcm::add_common_options(app, options);
   app.add_flag("--no-plot", so.no_plot, "Do not draw stretch.png");
-  app.add_option("--pulled-fraction", so.pulled_fraction,
-                 "Fraction of all nodes pulled at each end (default 0.025: the paper's outermost 5% of the nodes in\n"
-                 "total; 0.05 reads it as 5% at each end)")
+  app.add_option(
+         "--pulled-fraction", so.pulled_fraction,
+         "Fraction of all nodes pulled at each end (default 0.025: the paper's outermost 5% of the nodes in\n"
+         "total; 0.05 reads it as 5% at each end)")
       ->check(CLI::Range(0.001, 0.25));
   app.add_option("--forces-pN", so.forces_pN,
                  "Stretching forces in pN (default: the Mills 2004 forces and 200)")
