@@ -149,35 +149,46 @@ TEST(CortexModel, NewtonFindsTheSameEquilibriumAsFireInFewSteps) {
   EXPECT_LT(diff, 1e-4 * 3.25e-6);  // the same equilibrium
 }
 
+// Runs `steps` forward-Euler steps of size dt from the model's current positions; returns how many steps
+// were taken before a NumericalError (or all of them) and whether the energy never increased.
+std::pair<int, bool> run_steps(CortexModel<Exec>& model, double dt, int steps, double solve_dt) {
+  double e_prev = model.energy();
+  bool monotonic = true;
+  int done = 0;
+  try {
+    for (; done < steps; ++done) {
+      model.compute_forces();
+      model.solve_velocity(CgSettings{}, solve_dt);
+      model.advance(dt);
+      const double e = model.energy();
+      monotonic = monotonic && e <= e_prev;
+      e_prev = e;
+    }
+  } catch (const NumericalError&) {
+    return {done, false};
+  }
+  return {done, monotonic};
+}
+
+void set_positions(CortexModel<Exec>& model, const HostMesh& m) {
+  auto x = Kokkos::create_mirror_view(model.positions());
+  for (std::size_t i = 0; i < m.nodes.size(); ++i)
+    for (int d = 0; d < 3; ++d) x(i, d) = m.nodes[i][d];
+  Kokkos::deep_copy(model.positions(), x);
+}
+
 // Stiff global constraints (k_v = 1e4 Pa, k_d = 6e-3 N/m) on the 642-node Evans–Fung cell: forward Euler
 // with explicit forces blows up within a few steps at the paper's Δt; with the global terms linearly
 // implicit the energy decreases monotonically.
 TEST(CortexModel, ImplicitGlobalConstraintsAreStableWhereExplicitOnesAreNot) {
   const HostMesh rest = make_evans_fung(3);
+  HostMesh inflated = rest;  // inflated by 1%: area and volume both off their rest values
+  for (auto& x : inflated.nodes)
+    for (double& v : x) v *= 1.01;
   auto run = [&](bool implicit) {
     CortexModel<Exec> model(Exec(), {HostCell(rest)}, table1(0, 6e-3, 1e4));
-    auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), model.positions());
-    for (int i = 0; i < model.mesh().n_nodes; ++i)
-      for (int d = 0; d < 3; ++d)
-        x(i, d) *= 1.01;  // inflate by 1%: area and volume both off their rest values
-    Kokkos::deep_copy(model.positions(), x);
-    const double dt = 6e-6;
-    double e_prev = model.energy();
-    int steps = 0;
-    bool monotonic = true;
-    try {
-      for (; steps < 40; ++steps) {
-        model.compute_forces();
-        model.solve_velocity(CgSettings{}, implicit ? dt : 0.0);
-        model.advance(dt);
-        const double e = model.energy();
-        monotonic = monotonic && e <= e_prev;
-        e_prev = e;
-      }
-    } catch (const NumericalError&) {
-      return std::make_pair(steps, false);
-    }
-    return std::make_pair(steps, monotonic);
+    set_positions(model, inflated);
+    return run_steps(model, 6e-6, 40, implicit ? 6e-6 : 0.0);
   };
   const auto [explicit_steps, explicit_ok] = run(false);
   const auto [implicit_steps, implicit_ok] = run(true);
@@ -192,39 +203,17 @@ TEST(CortexModel, ImplicitGlobalConstraintsAreStableWhereExplicitOnesAreNot) {
 // and with the bending stiffness in the solve (Γ + Δt K_bend) it is not.
 TEST(CortexModel, ImplicitBendingIsStableWhereExplicitBendingIsNot) {
   const HostMesh rest = make_evans_fung(3);
+  HostMesh moved = rest;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-0.01e-6, 0.01e-6);
+  for (auto& x : moved.nodes)
+    for (double& v : x) v += u(rng);
   auto run = [&](bool implicit_bending) {
     MechanicsParams p = table1(6e-3, 6e-3, 1e4);
     p.implicit_bending = implicit_bending;
     CortexModel<Exec> model(Exec(), {HostCell(rest)}, p);
-    const HostMesh moved = [&] {
-      HostMesh m = rest;
-      std::mt19937 rng(9);
-      std::uniform_real_distribution<double> u(-0.01e-6, 0.01e-6);
-      for (auto& x : m.nodes)
-        for (double& v : x) v += u(rng);
-      return m;
-    }();
-    auto x = Kokkos::create_mirror_view(model.positions());
-    for (std::size_t i = 0; i < moved.nodes.size(); ++i)
-      for (int d = 0; d < 3; ++d) x(i, d) = moved.nodes[i][d];
-    Kokkos::deep_copy(model.positions(), x);
-    const double dt = 4e-5;
-    double e_prev = model.energy();
-    int steps = 0;
-    bool monotonic = true;
-    try {
-      for (; steps < 60; ++steps) {
-        model.compute_forces();
-        model.solve_velocity(CgSettings{}, dt);
-        model.advance(dt);
-        const double e = model.energy();
-        monotonic = monotonic && e <= e_prev;
-        e_prev = e;
-      }
-    } catch (const NumericalError&) {
-      return std::make_pair(steps, false);
-    }
-    return std::make_pair(steps, monotonic);
+    set_positions(model, moved);
+    return run_steps(model, 4e-5, 60, 4e-5);
   };
   const auto [explicit_steps, explicit_ok] = run(false);
   const auto [implicit_steps, implicit_ok] = run(true);
