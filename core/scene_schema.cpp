@@ -111,6 +111,10 @@ std::vector<ParamSpec> make_schema() {
                "volume constraint, E = k_v (V − V*)²/(2V*); Table 1's 10e3"),
 
       real_key("fluid.eta_Pa_s", "0.8e-3", 0, 10, kExcl, "Pa·s", "viscosity of the medium"),
+      real_key("body.gravity_m_per_s2", "0", 0, 1e3, kIncl, "m/s²",
+               "gravitational acceleration along −z (9.81 to switch gravity on; 0: no gravity term)"),
+      real_key("body.density_excess_kg_per_m3", "75", -1e4, 1e4, kIncl, "kg/m³",
+               "cell density minus medium density (RBC in plasma ≈ 1100 − 1025)"),
 
       real_key("contact.W_J_per_m2", "1e-3", 0, 1, kIncl, "J/m²", "work of adhesion"),
       real_key("contact.h0_m", "20e-9", 0, 1e-6, kExcl, "m", "range of adhesion (Dugdale)"),

@@ -46,7 +46,9 @@ struct MechanicsParams {
   double h_min = 1e4;             // 1/m, triangle curvature clamp
   bool multigrid = false;         // V-cycle preconditioner (where the mesh has an icosphere hierarchy)
   bool implicit_bending =
-      false;  // bending's Gauss-Newton stiffness in the solve (solvers/bending_stiffness.hpp)
+      false;                  // bending's Gauss-Newton stiffness in the solve (solvers/bending_stiffness.hpp)
+  double gravity = 0;         // m/s², along −z (paper eq. 32's F_gravity); 0: no gravity term
+  double density_excess = 0;  // kg/m³, cell minus medium (buoyant weight Δρ V* g per cell)
 };
 
 // Index of the first node with a non-finite component, or -1.
@@ -89,6 +91,7 @@ class CortexModel {
     if (p.k_volume > 0) volume_ = make_volume_rest(space_, mesh_, geo_);
     if (p.k_area_global > 0 || p.k_volume > 0)
       global_ = GlobalStiffness<Mem>(mesh_, p.k_area_global > 0, p.k_volume > 0);
+    if (p.gravity != 0 && p.density_excess != 0) gravity_ = node_weights(cells);
     friction_ = FrictionOperator<Mem>(mesh_, node_drag(cells), p.dashpot, p.dashpot_transverse);
     if (p.multigrid && (p.dashpot > 0 || p.dashpot_transverse > 0)) {
       multigrid_ = make_multigrid(cells, mesh_);
@@ -122,6 +125,7 @@ class CortexModel {
       add_area_forces(space_, mesh_, geo_, *area_, params_.k_area_local, params_.k_area_global, force_);
     if (volume_) add_volume_forces(space_, mesh_, geo_, *volume_, params_.k_volume, force_);
     add_external_forces(space_, external_, force_);
+    if (gravity_) add_external_forces(space_, *gravity_, force_);
     const int bad_node = first_non_finite_node(space_, force_);
     if (bad_node >= 0)
       throw NumericalError("non-finite force at node " + std::to_string(bad_node) +
@@ -132,6 +136,7 @@ class CortexModel {
   double energy() {
     update_geometry(space_, mesh_, geo_, params_.h_min);
     double e = external_energy(space_, external_, mesh_.x);
+    if (gravity_) e += external_energy(space_, *gravity_, mesh_.x);
     if (bonds_) e += fene_pow_energy(space_, mesh_, *bonds_, params_.bonds);
     if (hinges_) e += bending_energy(space_, mesh_, *hinges_, params_.k_b);
     if (area_) e += area_energy(space_, mesh_, geo_, *area_, params_.k_area_local, params_.k_area_global);
@@ -218,6 +223,22 @@ class CortexModel {
 
  private:
   // ζ_i = 6 π η r / N per cell, r the radius of the sphere with the cell's rest area.
+  // Gravity: each cell's buoyant weight Δρ V* g (V* its volume at construction), shared equally by its
+  // nodes, along −z. A constant field, so its energy is −Σ F_i · x_i like the external forces.
+  Vector node_weights(const std::vector<HostCell>& cells) {
+    Vector w("dcm::model::gravity_force", mesh_.n_nodes);
+    auto h = Kokkos::create_mirror_view(w);
+    const auto volume = to_host_vector(geo_.cell_volume);
+    int i = 0;
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      const int n = static_cast<int>(cells[c].mesh.nodes.size());
+      const double per_node = params_.density_excess * volume[c] * params_.gravity / n;
+      for (int k = 0; k < n; ++k, ++i) h(i, 2) = -per_node;
+    }
+    Kokkos::deep_copy(w, h);
+    return w;
+  }
+
   Kokkos::View<double*, Kokkos::LayoutRight, Mem> node_drag(const std::vector<HostCell>& cells) {
     Kokkos::View<double*, Kokkos::LayoutRight, Mem> drag("dcm::model::node_drag", mesh_.n_nodes);
     auto h = Kokkos::create_mirror_view(drag);
@@ -286,6 +307,7 @@ class CortexModel {
   std::optional<GlobalStiffness<Mem>> global_;
   std::optional<Multigrid<Mem>> multigrid_;
   std::optional<BendingStiffness<Mem>> bending_stiffness_;
+  std::optional<Vector> gravity_;
   FrictionOperator<Mem> friction_;
   CgWorkspace<Mem> cg_;
 };

@@ -268,11 +268,41 @@ TEST(CortexModel, WithoutDashpotsTheSolveIsDiagonal) {
   EXPECT_EQ(r.iterations, 0);
   // v = F / ζ exactly.
   const auto f = to_host_vector(model.force()), v = to_host_vector(model.velocity());
-  const double zeta =
-      6 * 3.14159265358979323846 * 0.8e-3 * to_host_vector(model.geometry().cell_area)[0] * 0 +
-      to_host_vector(model.friction().node_drag)[0];
+  const double zeta = to_host_vector(model.friction().node_drag)[0];
   for (std::size_t i = 0; i < f.size(); ++i)
     EXPECT_NEAR(v[i], f[i] / zeta, 1e-12 * std::fabs(f[i] / zeta) + 1e-30);
+}
+
+// Gravity on a cell at rest: the nodes carry the buoyant weight Δρ V g in total, and the cell sinks
+// rigidly at Stokes' velocity Δρ V g / (6πηr) (the dashpots see no relative motion).
+TEST(CortexModel, GravityGivesTheStokesSedimentationVelocity) {
+  MechanicsParams p = table1();
+  p.gravity = 9.81;
+  p.density_excess = 75;
+  const double r = 3.25e-6, pi = 3.14159265358979323846;
+  CortexModel<Exec> model(Exec(), {HostCell(make_icosphere(3, r))}, p);
+  model.compute_forces();
+  const auto f = to_host_vector(model.force());
+  const double volume = to_host_vector(model.geometry().cell_volume)[0];
+  const double area = to_host_vector(model.geometry().cell_area)[0];
+  double fz = 0;
+  for (std::size_t i = 2; i < f.size(); i += 3) fz += f[i];
+  const double weight = 75 * volume * 9.81;
+  EXPECT_NEAR(fz, -weight, 1e-9 * weight);
+  CgSettings cg;
+  cg.abs_tol = 0;
+  cg.rel_tol = 1e-12;
+  model.solve_velocity(cg);
+  const auto v = to_host_vector(model.velocity());
+  const double stokes = weight / (6 * pi * p.viscosity * std::sqrt(area / (4 * pi)));
+  for (std::size_t i = 0; i < v.size(); i += 3) {
+    EXPECT_NEAR(v[i + 2], -stokes, 1e-8 * stokes);
+    EXPECT_NEAR(v[i], 0, 1e-8 * stokes);
+  }
+  // Energy: the weight's potential −Σ F·x changes by weight × the sinking distance.
+  const double e0 = model.energy();
+  model.advance(1e-3);
+  EXPECT_NEAR(model.energy() - e0, -weight * stokes * 1e-3, 1e-6 * weight * stokes * 1e-3);
 }
 
 }  // namespace
