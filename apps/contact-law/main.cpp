@@ -56,7 +56,7 @@ bool validate(const Options& o) {
 void print_row(const dcm::MdState& st, const Options& o, const dcm::MdMaterial& mat) {
   const double L = dcm::md_length_unit(mat, o.R);
   const double lambda = dcm::md_lambda(mat, o.R);
-  const double force_unit = M_PI * mat.W * o.R;
+  const double force_unit = dcm::kMdPi * mat.W * o.R;
   const double m = st.a > 0 ? st.c / st.a : (st.c > 0 ? INFINITY : NAN);
   std::printf("%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", st.a, st.delta, m, st.c, lambda,
               L > 0 ? st.a / L : NAN, force_unit > 0 ? st.P / force_unit + 0.0 : NAN, st.P + 0.0);  // no -0
