@@ -1,0 +1,224 @@
+#pragma once
+// Adhesive contact of the rounded triangles with a plane (paper eqs. 15–19, MODEL.md section 4;
+// docs/model/contact.md). Per triangle t whose encompassing sphere (centre O_t, radius R_t;
+// kernels/rounded_triangle.hpp) comes within h0 of the plane and that faces the plane:
+//   overlap δ = R_t − dist(O_t, plane); Maugis–Dugdale state for (δ, R_t) (kernels/maugis_dugdale.hpp);
+//   contact centre C = the foot of O_t on the plane;
+//   regime 1, π c² ≥ 2 A_t / N_Q (eq. 18): the pressure p(r) integrated over the triangle by the N_Q-point
+//     rule, force F_t (eq. 16) and moment M_t about C (eq. 17);
+//   regime 2, a small disc: the net MD load times the fraction of the disc inside the triangle's
+//     projection, applied at C (or the nearest point of the triangle);
+//   distribution to the three nodes by the 3×3 solve of eq. 19 (kernels/contact_distribution.hpp).
+// The per-triangle results are kept (node loads, β weights for the substrate friction, contact area) and
+// gathered per node without atomics through the node → triangle-corner lists.
+#include "core/geometry.hpp"
+#include "core/vec3.hpp"
+#include "kernels/contact_distribution.hpp"
+#include "kernels/maugis_dugdale.hpp"
+#include "kernels/quadrature_rules.hpp"
+
+namespace dcm {
+
+// The plane {x : (x − point)·normal = 0}; the cells live on the side the unit normal points to.
+struct Plane {
+  Real3 point{0, 0, 0};
+  Real3 normal{0, 0, 1};
+};
+
+struct PlaneContactParams {
+  MdMaterial material{};       // K = 4/3 E/(1 − ν²), W, h0
+  int quadrature_points = 16;  // 1, 3, 7 or 16
+  bool projected_area = true;  // quadrature weights × the triangle's area projected on the plane (else A_t)
+};
+
+// What a triangle's contact is doing (tri_regime).
+enum ContactRegime : int { kNoContact = 0, kGap = 1, kQuadrature = 2, kSmallDisc = 3 };
+
+template <class MemorySpace>
+struct ContactBuffers {
+  template <class T>
+  using View = Kokkos::View<T, Kokkos::LayoutRight, MemorySpace>;
+  View<double* [3]> tri_node_load;  // normal force on each corner's node (N), along the plane normal
+  View<double* [3]> tri_beta;       // friction weights β of each corner (Σ = 1)
+  View<double*> tri_contact_area;   // A^C_t, the part of the triangle inside the contact radius a (m²)
+  View<double*> tri_load;           // F_t · n (N), repulsive positive
+  View<int*> tri_regime;            // ContactRegime
+
+  ContactBuffers() = default;
+  explicit ContactBuffers(int n_tris)
+      : tri_node_load("dcm::contact::tri_node_load", n_tris),
+        tri_beta("dcm::contact::tri_beta", n_tris),
+        tri_contact_area("dcm::contact::tri_contact_area", n_tris),
+        tri_load("dcm::contact::tri_load", n_tris),
+        tri_regime("dcm::contact::tri_regime", n_tris) {}
+};
+
+// Fraction of a disc of radius c centred at C inside the triangle (p0, p1, p2), all in the plane: the
+// product of the fractions on the inner side of each edge's line (exact for a disc that crosses one
+// edge; shared discs near a vertex are split approximately).
+KOKKOS_INLINE_FUNCTION double disc_fraction_in_triangle(Real3 p0, Real3 p1, Real3 p2, Real3 C, Real3 n,
+                                                        double c) {
+  const Real3 p[3] = {p0, p1, p2};
+  const double orient = dot(cross(p1 - p0, p2 - p0), n) >= 0 ? 1.0 : -1.0;
+  double fraction = 1;
+  for (int e = 0; e < 3; ++e) {
+    const Real3 a = p[e], b = p[(e + 1) % 3];
+    const Real3 inward = orient * cross(n, b - a);  // in the plane, towards the triangle's inside
+    const double len = norm(inward);
+    if (!(len > 0)) continue;
+    const double s = math::min(math::max(dot(C - a, inward) / (len * c), -1.0), 1.0);
+    fraction *= 1.0 - (math::acos(s) - s * math::sqrt(1.0 - s * s)) / kMdPi;
+  }
+  return fraction;
+}
+
+// The point of triangle (p0, p1, p2) nearest to C, all in one plane (C itself when inside).
+KOKKOS_INLINE_FUNCTION Real3 nearest_point_in_triangle(Real3 p0, Real3 p1, Real3 p2, Real3 C, Real3 n) {
+  const Real3 p[3] = {p0, p1, p2};
+  const double orient = dot(cross(p1 - p0, p2 - p0), n) >= 0 ? 1.0 : -1.0;
+  bool inside = true;
+  for (int e = 0; e < 3; ++e)
+    if (orient * dot(cross(p[(e + 1) % 3] - p[e], C - p[e]), n) < 0) inside = false;
+  if (inside) return C;
+  Real3 best = p0;
+  double best_d2 = norm2(C - p0);
+  for (int e = 0; e < 3; ++e) {
+    const Real3 a = p[e], d = p[(e + 1) % 3] - a;
+    const double dd = norm2(d);
+    const double t = dd > 0 ? math::min(math::max(dot(C - a, d) / dd, 0.0), 1.0) : 0.0;
+    const Real3 q = a + t * d;
+    if (norm2(C - q) < best_d2) {
+      best_d2 = norm2(C - q);
+      best = q;
+    }
+  }
+  return best;
+}
+
+// Per-triangle contact with the plane (needs update_geometry(): tri_area, tri_normal, the spheres).
+template <class ExecutionSpace, class MemorySpace>
+void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                           const GeometryBuffers<MemorySpace>& geo, const Plane& plane,
+                           const PlaneContactParams& params, const ContactBuffers<MemorySpace>& out) {
+  const auto x = mesh.x;
+  const auto tri = mesh.tri;
+  const auto tri_area = geo.tri_area;
+  const auto tri_normal = geo.tri_normal;
+  const auto center = geo.tri_sphere_center;
+  const auto radius = geo.tri_sphere_radius;
+  const auto node_load = out.tri_node_load;
+  const auto beta = out.tri_beta;
+  const auto contact_area = out.tri_contact_area;
+  const auto load = out.tri_load;
+  const auto regime = out.tri_regime;
+  const double len = norm(plane.normal);
+  const Real3 n = (1.0 / len) * plane.normal, p_plane = plane.point;
+  const PlaneContactParams prm = params;
+  Kokkos::parallel_for(
+      "dcm::contact::plane", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_tris),
+      KOKKOS_LAMBDA(const int t) {
+        for (int k = 0; k < 3; ++k) {
+          node_load(t, k) = 0;
+          beta(t, k) = 0;
+        }
+        contact_area(t) = 0;
+        load(t) = 0;
+        regime(t) = kNoContact;
+        const Real3 x0 = load3(x, tri(t, 0)), x1 = load3(x, tri(t, 1)), x2 = load3(x, tri(t, 2));
+        const double R = radius(t);
+        const Real3 O = load3(center, t);
+        const double height = dot(O - p_plane, n);  // of the sphere centre
+        const double delta = R - height;
+        // Broad phase: the sphere within h0, the triangle facing the plane, and the triangle itself
+        // within h0 plus its size of the plane (a flat triangle far above has a huge sphere too).
+        if (!(delta > -prm.material.h0) || !(dot(load3(tri_normal, t), n) < 0)) return;
+        const double span = math::max(math::max(norm(x1 - x0), norm(x2 - x1)), norm(x0 - x2));
+        const double lowest =
+            math::min(math::min(dot(x0 - p_plane, n), dot(x1 - p_plane, n)), dot(x2 - p_plane, n));
+        if (!(lowest < prm.material.h0 + span)) return;
+        const MdState st = md_state_from_overlap(delta, R, prm.material);
+        const double outer = math::max(st.a, st.c);
+        if (!(outer > 0)) return;
+        const Real3 C = O - height * n;
+        const double area_t = tri_area(t);
+        const double area_q = prm.projected_area ? 0.5 * math::fabs(dot(cross(x1 - x0, x2 - x0), n)) : area_t;
+        double Fn = 0, a_contact = 0;
+        Real3 M{0, 0, 0}, C_apply = C;
+        const int nq = prm.quadrature_points;
+        if (kMdPi * outer * outer * nq >= 2.0 * area_t) {  // eq. 18, regime 1: quadrature (eqs. 16–17)
+          integrate_pressure(
+              x0, x1, x2, C, n, area_q, nq, [&](Real3 r) { return md_pressure(st, norm(r)); }, Fn, M);
+          double inside = 0;
+          for (int q = 0; q < nq; ++q) {
+            double l1, l2, l3, w;
+            quadrature_point(nq, q, l1, l2, l3, w);
+            const Real3 rel = l1 * x0 + l2 * x1 + l3 * x2 - C;
+            const Real3 r = rel - dot(rel, n) * n;
+            if (norm2(r) < st.a * st.a) inside += w;
+          }
+          a_contact = inside * area_q;
+          regime(t) = st.a > 0 ? kQuadrature : kGap;
+        } else {  // regime 2: the disc's share of the net load, at C or the triangle's nearest point
+          const Real3 q0 = x0 - dot(x0 - C, n) * n, q1 = x1 - dot(x1 - C, n) * n,
+                      q2 = x2 - dot(x2 - C, n) * n;
+          const double fraction = disc_fraction_in_triangle(q0, q1, q2, C, n, outer);
+          Fn = fraction * st.P;
+          a_contact = fraction * kMdPi * st.a * st.a;
+          C_apply = nearest_point_in_triangle(q0, q1, q2, C, n);
+          regime(t) = st.a > 0 ? kSmallDisc : kGap;
+        }
+        const NodeLoads nl = distribute_normal_load(x0, x1, x2, C_apply, n, Fn, M);  // eq. 19
+        for (int k = 0; k < 3; ++k) {
+          node_load(t, k) = nl.f[k];
+          beta(t, k) = nl.beta[k];
+        }
+        load(t) = Fn;
+        contact_area(t) = a_contact;
+      });
+}
+
+// Adds the contact forces (along the plane normal) gathered from the triangles' corners to force.
+template <class ExecutionSpace, class MemorySpace>
+void add_plane_contact_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                              const Plane& plane, const ContactBuffers<MemorySpace>& contact,
+                              const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& force) {
+  const auto offsets = mesh.node_tri_offsets;
+  const auto corners = mesh.node_tri_corners;
+  const auto node_load = contact.tri_node_load;
+  const Real3 n = (1.0 / norm(plane.normal)) * plane.normal;
+  Kokkos::parallel_for(
+      "dcm::contact::gather", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
+      KOKKOS_LAMBDA(const int i) {
+        double f = 0;
+        for (int k = offsets(i); k < offsets(i + 1); ++k) {
+          const int corner = corners(k);
+          f += node_load(corner / 3, corner % 3);
+        }
+        if (f != 0)
+          for (int d = 0; d < 3; ++d) force(i, d) += f * (d == 0 ? n.x : d == 1 ? n.y : n.z);
+      });
+}
+
+// Σ_t A^C_t per cell is what r_cc = sqrt(A^C / π) needs; here the whole mesh (one cell).
+template <class ExecutionSpace, class MemorySpace>
+double total_contact_area(const ExecutionSpace& space, const ContactBuffers<MemorySpace>& contact) {
+  const auto a = contact.tri_contact_area;
+  double sum = 0;
+  Kokkos::parallel_reduce(
+      "dcm::contact::area", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.extent(0)),
+      KOKKOS_LAMBDA(const int t, double& s) { s += a(t); }, sum);
+  return sum;
+}
+
+// Σ_t F_t · n (N).
+template <class ExecutionSpace, class MemorySpace>
+double total_contact_load(const ExecutionSpace& space, const ContactBuffers<MemorySpace>& contact) {
+  const auto f = contact.tri_load;
+  double sum = 0;
+  Kokkos::parallel_reduce(
+      "dcm::contact::load", Kokkos::RangePolicy<ExecutionSpace>(space, 0, f.extent(0)),
+      KOKKOS_LAMBDA(const int t, double& s) { s += f(t); }, sum);
+  return sum;
+}
+
+}  // namespace dcm
