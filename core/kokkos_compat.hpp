@@ -10,6 +10,7 @@ namespace math {
 
 #if KOKKOS_VERSION >= 30700
 using Kokkos::acos;
+using Kokkos::asin;
 using Kokkos::atan;
 using Kokkos::atan2;
 using Kokkos::cbrt;
@@ -23,6 +24,7 @@ using Kokkos::sin;
 using Kokkos::sqrt;
 #else
 using Kokkos::Experimental::acos;
+using Kokkos::Experimental::asin;
 using Kokkos::Experimental::atan;
 using Kokkos::Experimental::atan2;
 using Kokkos::Experimental::cbrt;

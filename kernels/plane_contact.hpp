@@ -15,6 +15,7 @@
 #include "core/vec3.hpp"
 #include "kernels/contact_distribution.hpp"
 #include "kernels/maugis_dugdale.hpp"
+#include "kernels/polar_contact_integral.hpp"
 #include "kernels/quadrature_rules.hpp"
 
 namespace dcm {
@@ -27,7 +28,7 @@ struct Plane {
 
 struct PlaneContactParams {
   MdMaterial material{};       // K = 4/3 E/(1 − ν²), W, h0
-  int quadrature_points = 16;  // 1, 3, 7 or 16
+  int quadrature_points = 16;  // 1, 3, 7 or 16 (the paper's rules, eq. 18); 0: exact polar integration
   bool projected_area = true;  // quadrature weights × the triangle's area projected on the plane (else A_t)
 };
 
@@ -145,7 +146,17 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
         double Fn = 0, a_contact = 0;
         Real3 M{0, 0, 0}, C_apply = C;
         const int nq = prm.quadrature_points;
-        if (kMdPi * outer * outer * nq >= 2.0 * area_t) {  // eq. 18, regime 1: quadrature (eqs. 16–17)
+        if (nq == 0) {  // exact in r, Gauss in θ (kernels/polar_contact_integral.hpp); no regimes needed
+          const Real3 ref = math::fabs(n.x) < 0.9 ? Real3{1, 0, 0} : Real3{0, 1, 0};
+          Real3 e1 = cross(ref, n);
+          e1 = (1.0 / norm(e1)) * e1;
+          const Real3 e2 = cross(n, e1);
+          const PolarIntegral pi = polar_contact_integral(st, x0, x1, x2, C, e1, e2);
+          Fn = pi.load;
+          M = pi.m1 * e1 + pi.m2 * e2;
+          a_contact = pi.contact_area;
+          regime(t) = st.a > 0 ? kQuadrature : kGap;
+        } else if (kMdPi * outer * outer * nq >= 2.0 * area_t) {  // eq. 18, regime 1: quadrature (eqs. 16–17)
           integrate_pressure(
               x0, x1, x2, C, n, area_q, nq, [&](Real3 r) { return md_pressure(st, norm(r)); }, Fn, M);
           double inside = 0;

@@ -31,18 +31,16 @@ struct SphereContact {
   double load = 0, node_load = 0, area = 0, edge = 0;
 };
 
-// An icosphere of radius kR (k subdivisions), rotated by `tilt` about x, its lowest point δ below the plane.
-SphereContact press_sphere(int k, double a, const PlaneContactParams& prm, double tilt = 0) {
+// An icosphere of radius kR (k subdivisions), rotated by `tilt` about x, its centre kR − δ above the plane
+// (δ < 0: a gap).
+SphereContact sphere_at_overlap(int k, double delta, const PlaneContactParams& prm, double tilt = 0) {
   HostMesh m = make_icosphere(k, kR);
-  double zmin = 1;
   for (auto& x : m.nodes) {
     const double y = x[1] * std::cos(tilt) - x[2] * std::sin(tilt),
                  z = x[1] * std::sin(tilt) + x[2] * std::cos(tilt);
     x[1] = y;
     x[2] = z;
-    zmin = std::fmin(zmin, z);
   }
-  const double delta = kR - std::sqrt(kR * kR - a * a);  // geometric overlap of the perfect sphere
   for (auto& x : m.nodes) x[2] += kR - delta;
   const Exec space;
   const MeshBuffers<Mem> mesh = upload_cells<Mem>({HostCell(m)});
@@ -70,14 +68,24 @@ SphereContact press_sphere(int k, double a, const PlaneContactParams& prm, doubl
   return r;
 }
 
+// The same sphere with contact radius a (the perfect sphere's geometric overlap).
+SphereContact press_sphere(int k, double a, const PlaneContactParams& prm, double tilt = 0) {
+  return sphere_at_overlap(k, kR - std::sqrt(kR * kR - a * a), prm, tilt);
+}
+
+// Mesh independence (the paper's central claim, MODEL.md section 4): Σ of the triangle loads of a rigid
+// icosphere against the continuum MD load of the perfect sphere at the same contact radius, for contact
+// radii from one mean edge length to a/R = 0.5, two orientations (a node or an edge at the bottom), three λ.
+// Exact polar integration (quadrature_points = 0, dcm's default) to 1e-3; the paper's rules are printed
+// (docs/VALIDATION.md tabulates them) and the 16-point rule checked in the DMT-like case it resolves.
 TEST(PlaneContact, RigidSphereMatchesTheContinuumLaw) {
   for (int k : {3, 4}) {
     for (double lambda : {0.1, 1.0, 10.0}) {
-      for (int nq : {1, 3, 7, 16}) {
+      for (int nq : {0, 1, 3, 7, 16}) {
         PlaneContactParams prm;
         prm.material = material_for_lambda(lambda);
         prm.quadrature_points = nq;
-        double worst = 0;
+        double worst = 0, worst_area = 0, worst_sum = 0;
         const double edge = press_sphere(k, 0.3e-6, prm).edge;
         for (double a_over_R : {0.0, 0.1, 0.2, 0.3, 0.4, 0.5}) {
           const double a = a_over_R == 0 ? edge : a_over_R * kR;
@@ -85,18 +93,95 @@ TEST(PlaneContact, RigidSphereMatchesTheContinuumLaw) {
           for (double tilt : {0.0, 0.3}) {
             const SphereContact s = press_sphere(k, a, prm, tilt);
             const MdState exact = md_state_from_radius(a, kR, prm.material);
-            const double err = std::fabs(s.load - exact.P) / std::fabs(exact.P);
-            worst = std::fmax(worst, err);
-            if (nq == 16)
-              std::printf(
-                  "k=%d lambda=%g nq=%d a/R=%.3f tilt=%.1f  P=%.4e exact=%.4e err=%.2e  nodeΣ-Σ=%.1e  "
-                  "r_cc/a=%.3f\n",
-                  k, lambda, nq, a / kR, tilt, s.load, exact.P, err,
-                  std::fabs(s.node_load - s.load) / std::fabs(s.load), std::sqrt(s.area / kPi) / a);
+            worst = std::fmax(worst, std::fabs(s.load - exact.P) / std::fabs(exact.P));
+            worst_area = std::fmax(worst_area, std::fabs(std::sqrt(s.area / kPi) / a - 1));
+            worst_sum = std::fmax(worst_sum, std::fabs(s.node_load - s.load) / std::fabs(s.load));
           }
         }
-        std::printf("nodes=%d lambda=%g nq=%d worst=%.3e\n", 10 * (1 << (2 * k)) + 2, lambda, nq, worst);
+        std::printf(
+            "nodes %5d  lambda %4g  rule %2d  max |sum F_t - P_MD| / |P_MD| = %.2e  max |r_cc/a - 1| = "
+            "%.2e\n",
+            10 * (1 << (2 * k)) + 2, lambda, nq, worst, worst_area);
+        EXPECT_LT(worst_sum, 1e-12) << "node forces add up to the triangle loads";
+        if (nq == 0) {
+          EXPECT_LT(worst, 1e-3) << "nodes " << 10 * (1 << (2 * k)) + 2 << " lambda " << lambda;
+          EXPECT_LT(worst_area, 1e-3);
+        }
+        if (nq == 16 && lambda == 0.1) {
+          EXPECT_LT(worst, k == 4 ? 0.02 : 0.05);
+        }
       }
+    }
+  }
+}
+
+// Below one edge length the error is reported (docs/VALIDATION.md), and the load stays finite and close.
+TEST(PlaneContact, SmallContactsStayAccurateWithExactIntegration) {
+  PlaneContactParams prm;
+  prm.material = material_for_lambda(1.0);
+  prm.quadrature_points = 0;
+  for (double a : {0.02e-6, 0.05e-6, 0.1e-6}) {
+    const SphereContact s = press_sphere(3, a, prm, 0.3);
+    const MdState exact = md_state_from_radius(a, kR, prm.material);
+    std::printf("642 nodes, a = %.2f um: error %.2e\n", a * 1e6,
+                std::fabs(s.load - exact.P) / std::fabs(exact.P));
+    EXPECT_LT(std::fabs(s.load - exact.P), 1e-2 * std::fabs(exact.P));
+  }
+}
+
+// A rigid icosphere that can be moved along z without rebuilding anything.
+struct MovableSphere {
+  MeshBuffers<Mem> mesh;
+  GeometryBuffers<Mem> geo;
+  ContactBuffers<Mem> contact;
+  std::vector<double> x0;
+  MovableSphere(int k, double tilt)
+      : mesh(upload_cells<Mem>({HostCell(make_icosphere(k, kR))})), geo(mesh), contact(mesh.n_tris) {
+    x0 = to_host_vector(mesh.x);
+    for (std::size_t i = 0; i < x0.size(); i += 3) {
+      const double y = x0[i + 1] * std::cos(tilt) - x0[i + 2] * std::sin(tilt);
+      x0[i + 2] = x0[i + 1] * std::sin(tilt) + x0[i + 2] * std::cos(tilt);
+      x0[i + 1] = y;
+    }
+  }
+  double load_at(double delta, const PlaneContactParams& prm) {
+    auto h = Kokkos::create_mirror_view(mesh.x);
+    for (int i = 0; i < mesh.n_nodes; ++i)
+      for (int d = 0; d < 3; ++d) h(i, d) = x0[3 * i + d] + (d == 2 ? kR - delta : 0.0);
+    Kokkos::deep_copy(mesh.x, h);
+    const Exec space;
+    update_geometry(space, mesh, geo, 1e4);
+    compute_plane_contact(space, mesh, geo, Plane{}, prm, contact);
+    return total_contact_load(space, contact);
+  }
+};
+
+// Continuity through contact onset (δ = 0) and the end of the gap branch (gap h0): swept in steps of h0/4000
+// across both, no step changes the load by more than 1% of 2πWR (a jump would, whatever the step). The
+// paper's 16-point rule jumps where the adhesive edge r = c passes a quadrature point: reported, not
+// asserted.
+TEST(PlaneContact, LoadIsContinuousThroughOnsetAndTheEndOfTheGapBranch) {
+  MovableSphere sphere(3, 0.3);
+  for (int nq : {0, 16}) {
+    PlaneContactParams prm;
+    prm.material = md_material(kE, kNu, kW, 20e-9);
+    prm.quadrature_points = nq;
+    const double h0 = prm.material.h0, scale = 2 * kPi * kW * kR;
+    EXPECT_EQ(sphere.load_at(-1.001 * h0, prm), 0.0) << "no force beyond the range h0";
+    EXPECT_LT(sphere.load_at(-0.999 * h0, prm), 0.0) << "adhesion inside the range";
+    double worst = 0;
+    for (double centre : {0.0, -h0}) {
+      double prev = sphere.load_at(centre - 0.05 * h0, prm);
+      for (int i = 1; i <= 400; ++i) {
+        const double load = sphere.load_at(centre - 0.05 * h0 + i * h0 / 4000, prm);
+        worst = std::fmax(worst, std::fabs(load - prev));
+        prev = load;
+      }
+    }
+    std::printf("rule %2d: largest load change per h0/4000 step near onset and gap end: %.2e of 2 pi W R\n",
+                nq, worst / scale);
+    if (nq == 0) {
+      EXPECT_LT(worst, 0.01 * scale);
     }
   }
 }

@@ -1,0 +1,162 @@
+#pragma once
+// Exact-in-r integration of the Maugis–Dugdale pressure over a triangle (dcm's alternative to the paper's
+// N_Q-point rule, docs/model/contact.md): the pressure is radial about the contact centre C, so in polar
+// coordinates about C
+//   F = ∫∫ p dA = Σ_edges ∫ G(ρ(θ)) dθ,            G(ρ) = ∫_0^ρ p(r) r dr   (closed form),
+//   M = ∫∫ r × p n dA = Σ_edges ∫ H(ρ(θ)) (ê(θ) × n) dθ,  H(ρ) = ∫_0^ρ p(r) r² dr,
+// where each edge (P, Q) of the triangle, projected on the plane, sweeps the sector (C, P, Q) (signed) and
+// ρ(θ) is the distance from C to the edge along ê(θ). The step of p at r = c and the square root at r = a
+// are integrated exactly in r; θ is integrated by 8-point Gauss–Legendre on pieces split where ρ(θ) crosses
+// a and c, so the integrand is smooth on each piece. Same for the contact area with G_A(ρ) = min(ρ, a)²/2.
+#include "core/vec3.hpp"
+#include "kernels/maugis_dugdale.hpp"
+
+namespace dcm {
+
+// 8-point Gauss–Legendre on [−1, 1].
+KOKKOS_INLINE_FUNCTION void gauss_legendre8(int i, double& x, double& w) {
+  constexpr double xs[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267, 0.9602898564975363};
+  constexpr double ws[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
+  const int k = i < 4 ? 3 - i : i - 4;
+  x = i < 4 ? -xs[k] : xs[k];
+  w = ws[k];
+}
+
+// G(ρ) = ∫_0^ρ p(r) r dr (N/m... i.e. Pa·m²): the load inside radius ρ is 2π G(ρ).
+KOKKOS_INLINE_FUNCTION double md_radial_load(const MdState& st, double rho) {
+  double g = 0;
+  const double a = st.a;
+  if (a > 0) {
+    const double r = math::min(rho, a);
+    const double u = math::sqrt(math::max(a * a - r * r, 0.0));
+    g += st.p0 / (3.0 * a) * (a * a * a - u * u * u);  // Hertz (eq. 5)
+    const double w = math::sqrt(math::max(st.c * st.c - a * a, 0.0));
+    if (st.sigma0 > 0 && w > 0) {  // Dugdale inside a (eq. 7): −(2σ0/π) atan(w / sqrt(a² − r²))
+      auto F = [&](double v) {
+        return 0.5 * v * v * math::atan2(w, v) + 0.5 * w * v - 0.5 * w * w * math::atan2(v, w);
+      };
+      g -= 2.0 / kMdPi * st.sigma0 * (F(a) - F(u));
+    }
+  }
+  if (rho > a && st.c > a) {  // −σ0 on a < r < c
+    const double r = math::min(rho, st.c);
+    g -= 0.5 * st.sigma0 * (r * r - a * a);
+  }
+  return g;
+}
+
+// H(ρ) = ∫_0^ρ p(r) r² dr (Pa·m³).
+KOKKOS_INLINE_FUNCTION double md_radial_moment(const MdState& st, double rho) {
+  double h = 0;
+  const double a = st.a;
+  if (a > 0) {
+    const double r = math::min(rho, a);
+    const double u = math::sqrt(math::max(a * a - r * r, 0.0));
+    const double phi_end = math::asin(math::min(r / a, 1.0));
+    // Hertz: (p0/a) ∫ r² sqrt(a² − r²) dr
+    h += st.p0 / a * (r * (2 * r * r - a * a) * u + a * a * a * a * phi_end) / 8.0;
+    const double w = math::sqrt(math::max(st.c * st.c - a * a, 0.0));
+    if (st.sigma0 > 0 && w > 0 && phi_end > 0) {  // Dugdale inside a, r = a sin φ (smooth in φ)
+      double s = 0;
+      for (int i = 0; i < 8; ++i) {
+        double x, wt;
+        gauss_legendre8(i, x, wt);
+        const double phi = 0.5 * phi_end * (x + 1);
+        const double sn = math::sin(phi), cs = math::cos(phi);
+        s += wt * math::atan2(w, a * cs) * sn * sn * cs;
+      }
+      h -= 2.0 / kMdPi * st.sigma0 * a * a * a * 0.5 * phi_end * s;
+    }
+  }
+  if (rho > a && st.c > a) {
+    const double r = math::min(rho, st.c);
+    h -= st.sigma0 * (r * r * r - a * a * a) / 3.0;
+  }
+  return h;
+}
+
+struct PolarIntegral {
+  double load = 0;          // ∫ p dA (N)
+  double m1 = 0, m2 = 0;    // moment about C in the basis (e1, e2) of the plane (N·m)
+  double contact_area = 0;  // area of the triangle within r < a (m²)
+};
+
+namespace detail {
+// One signed sector (C = origin, P, Q) in plane coordinates.
+KOKKOS_INLINE_FUNCTION void polar_sector(const MdState& st, double px, double py, double qx, double qy,
+                                         PolarIntegral& out) {
+  const double cr = px * qy - py * qx, dt = px * qx + py * qy;
+  const double dx = qx - px, dy = qy - py, len2 = dx * dx + dy * dy;
+  if (!(len2 > 0) || cr == 0) return;
+  const double span = math::atan2(cr, dt);  // signed angle from P to Q
+  const double theta_p = math::atan2(py, px);
+  // Distance from C to the line PQ and the direction of its foot (from d, robust when C is near the line).
+  const double len = math::sqrt(len2);
+  const double hdist = math::fabs(cr) / len;
+  const double side = (dy * px - dx * py) >= 0 ? 1.0 : -1.0;
+  const double theta_f = math::atan2(-side * dx, side * dy);
+  // Break points (as offsets s in (0, span) from θ_P) where ρ(θ) = a or c.
+  double cuts[6];
+  int n_cuts = 0;
+  cuts[n_cuts++] = 0;
+  const double radii[2] = {st.a, st.c};
+  for (int k = 0; k < 2; ++k) {
+    if (!(radii[k] > hdist)) continue;
+    const double phi = math::acos(hdist / radii[k]);
+    for (int sgn = -1; sgn <= 1; sgn += 2) {
+      double s = theta_f + sgn * phi - theta_p;
+      while (s > kMdPi) s -= 2 * kMdPi;
+      while (s <= -kMdPi) s += 2 * kMdPi;
+      if ((span > 0 && s > 0 && s < span) || (span < 0 && s < 0 && s > span)) cuts[n_cuts++] = s;
+    }
+  }
+  cuts[n_cuts++] = span;
+  for (int i = 1; i < n_cuts; ++i)  // insertion sort by distance from 0 along the sweep
+    for (int j = i; j > 0 && math::fabs(cuts[j]) < math::fabs(cuts[j - 1]); --j) {
+      const double tmp = cuts[j];
+      cuts[j] = cuts[j - 1];
+      cuts[j - 1] = tmp;
+    }
+  for (int piece = 0; piece + 1 < n_cuts; ++piece) {
+    const double s0 = cuts[piece], s1 = cuts[piece + 1], half = 0.5 * (s1 - s0);
+    if (half == 0) continue;
+    for (int i = 0; i < 8; ++i) {
+      double x, wt;
+      gauss_legendre8(i, x, wt);
+      const double theta = theta_p + s0 + half * (x + 1);
+      const double rho = cr / (math::cos(theta) * dy - math::sin(theta) * dx);  // ray from C meets PQ
+      const double weight = wt * half;
+      const double hm = md_radial_moment(st, rho);
+      out.load += weight * md_radial_load(st, rho);
+      out.m1 += weight * hm * math::sin(theta);  // ê × n = sin θ e1 − cos θ e2
+      out.m2 -= weight * hm * math::cos(theta);
+      const double ra = math::min(rho, st.a);
+      out.contact_area += weight * 0.5 * ra * ra;
+    }
+  }
+}
+}  // namespace detail
+
+// ∫ over the triangle (x0, x1, x2) projected on the plane through C with unit normal n, of the radial MD
+// pressure about C; (e1, e2) an orthonormal basis of the plane with e1 × e2 = n.
+KOKKOS_INLINE_FUNCTION PolarIntegral polar_contact_integral(const MdState& st, Real3 x0, Real3 x1, Real3 x2,
+                                                            Real3 C, Real3 e1, Real3 e2) {
+  const Real3 xs[3] = {x0, x1, x2};
+  double qx[3], qy[3];
+  for (int k = 0; k < 3; ++k) {
+    qx[k] = dot(xs[k] - C, e1);
+    qy[k] = dot(xs[k] - C, e2);
+  }
+  PolarIntegral out;
+  for (int k = 0; k < 3; ++k) detail::polar_sector(st, qx[k], qy[k], qx[(k + 1) % 3], qy[(k + 1) % 3], out);
+  const double orientation = (qx[1] - qx[0]) * (qy[2] - qy[0]) - (qy[1] - qy[0]) * (qx[2] - qx[0]);
+  if (orientation < 0) {
+    out.load = -out.load;
+    out.m1 = -out.m1;
+    out.m2 = -out.m2;
+    out.contact_area = -out.contact_area;
+  }
+  return out;
+}
+
+}  // namespace dcm
