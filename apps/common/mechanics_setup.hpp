@@ -1,23 +1,15 @@
 #pragma once
 // From a scene to the cells and the mechanical constants of a run (shared by the mechanics apps).
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "core/host_mesh.hpp"
 #include "core/scene.hpp"
 #include "solvers/cortex_model.hpp"
+#include "solvers/deflation.hpp"
 
 namespace dcm {
-
-inline HostMesh cell_mesh_from_scene(const Scene& scene) {
-  const int k = static_cast<int>(scene.get_int("mesh.subdivisions"));
-  if (scene.get_string("mesh.shape") == "evans_fung") {
-    EvansFungShape shape;
-    shape.diameter = scene.get_real("mesh.diameter_m");
-    return make_evans_fung(k, shape);
-  }
-  return make_icosphere(k, scene.get_real("mesh.radius_m"));
-}
 
 // Table 1 constants as the energies of docs/model/ use them (docs/MODEL.md section 3 says why):
 // k_s (N/m), x_max, k_b (J), c (N·s/m) as given; cortex.k_a, cortex.k_d (N/m) and cortex.k_v (Pa) are the
@@ -39,6 +31,25 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
   p.gravity = scene.get_real("body.gravity_m_per_s2");
   p.density_excess = scene.get_real("body.density_excess_kg_per_m3");
   return p;
+}
+
+// The cell's start shape (mesh.shape). Kokkos must be initialised: "deflated" relaxes the sphere with the
+// scene's cortex constants (solvers/deflation.hpp) on the default execution space.
+inline HostMesh cell_mesh_from_scene(const Scene& scene) {
+  const int k = static_cast<int>(scene.get_int("mesh.subdivisions"));
+  const std::string shape = scene.get_string("mesh.shape");
+  if (shape == "evans_fung") {
+    EvansFungShape ef;
+    ef.diameter = scene.get_real("mesh.diameter_m");
+    return make_evans_fung(k, ef);
+  }
+  HostMesh sphere = make_icosphere(k, scene.get_real("mesh.radius_m"));
+  if (shape == "deflated") {
+    DeflationSettings s;
+    s.volume_fraction = scene.get_real("mesh.deflated_volume_fraction");
+    return deflate_sphere(Kokkos::DefaultExecutionSpace(), sphere, mechanics_from_scene(scene), s).mesh;
+  }
+  return sphere;
 }
 
 inline CgSettings cg_settings_from_scene(const Scene& scene) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "apps/common/app_cli.hpp"
+#include "apps/common/mechanics_setup.hpp"
 #include "core/h5_output.hpp"
 #include "core/host_copy.hpp"
 #include "core/json_writer.hpp"
@@ -17,16 +18,6 @@ namespace dcm {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-HostMesh mesh_from_scene(const Scene& scene) {
-  const int k = static_cast<int>(scene.get_int("mesh.subdivisions"));
-  if (scene.get_string("mesh.shape") == "evans_fung") {
-    EvansFungShape shape;
-    shape.diameter = scene.get_real("mesh.diameter_m");
-    return make_evans_fung(k, shape);
-  }
-  return make_icosphere(k, scene.get_real("mesh.radius_m"));
-}
 
 struct Stats {
   double min = INFINITY, max = -INFINITY, sum = 0;
@@ -52,7 +43,7 @@ void run(const AppOptions& options) {
   using Mem = Exec::memory_space;
 
   auto t0 = std::chrono::steady_clock::now();
-  const std::vector<HostCell> cells{HostCell(mesh_from_scene(scene))};
+  const std::vector<HostCell> cells{HostCell(cell_mesh_from_scene(scene))};
   const double t_generate = seconds_since(t0);
   t0 = std::chrono::steady_clock::now();
   const MeshBuffers<Mem> mesh = upload_cells<Mem>(cells);
