@@ -174,7 +174,8 @@ class CortexModel {
       update_global_stiffness(space_, mesh_, geo_, area_ ? area_->cell_area : volume_->cell_volume,
                               volume_ ? volume_->cell_volume : area_->cell_area, params_.k_area_global,
                               params_.k_volume, dt, *global_);
-    if (params_.dashpot == 0 && params_.dashpot_transverse == 0 && !implicit && !implicit_bending) {
+    if (params_.dashpot == 0 && params_.dashpot_transverse == 0 && !friction_.substrate && !implicit &&
+        !implicit_bending) {
       apply_block_jacobi(space_, friction_, force_, velocity_);
       CgResult r;
       r.converged = true;

@@ -1,13 +1,18 @@
 #pragma once
 // The friction operator Γ of the overdamped equation of motion Γ v = F (paper eqs. 25, 30-32), applied
 // matrix-free:
-//   (Γ v)_i = ζ_i v_i + Σ_{bonds b = (i, j)} c (n̂_b · (v_i − v_j)) n̂_b        (+ contact blocks, later)
+//   (Γ v)_i = ζ_i v_i + Σ_{bonds b = (i, j)} c (n̂_b · (v_i − v_j)) n̂_b
+//           + Σ_{triangles t ∋ i in contact} β_ti Γ_t Σ_{j ∈ t} β_tj v_j                   (substrate)
 // ζ_i = 6 π η r_cell / N_cell is the liquid (Stokes) drag spread over the cell's nodes (isotropic),
 // c the Kelvin–Voigt dashpot coefficient of every bond (eq. 25), n̂_b the unit bond direction.
 // Optionally a transverse part c_t (I − n̂n̂ᵀ) per bond: c_t = c makes the bond friction c (v_i − v_j), the
 // form written in the paper's eq. 32 (it damps out-of-plane and shear relative motion, which eq. 25 does
 // not, but also rigid rotations). Each bond block M_b = c n̂n̂ᵀ + c_t (I − n̂n̂ᵀ) is positive semi-definite,
 // so Γ = ζ I + Σ_b [M_b −M_b; −M_b M_b] is symmetric positive definite.
+//
+// Substrate friction (MODEL.md section 5): Γ_t = A^C_t [γ_n n̂n̂ᵀ + γ_t (I − n̂n̂ᵀ)] acts on the velocity of
+// the triangle's contact point Σ_j β_tj v_j, spread back with the same weights β (those of the contact force,
+// kernels/plane_contact.hpp): the blocks β_ti β_tj Γ_t are symmetric positive semi-definite.
 //
 // Coefficients (n̂_b and each node's 3×3 diagonal block, inverted for the block-Jacobi preconditioner)
 // are cached once per step by update(); apply() is a gather over each node's bonds (no atomics).
@@ -30,6 +35,14 @@ struct FrictionOperator {
   View<double* [3]> bond_dir;       // n̂_b, cached per step
   View<double* [6]> block_inverse;  // inverse of each node's 3×3 diagonal block: xx, yy, zz, xy, xz, yz
 
+  // Substrate friction; off (no kernels) unless enable_substrate_friction() was called.
+  bool substrate = false;
+  double gamma_n = 0, gamma_t = 0;  // N·s/m³
+  Real3 substrate_normal{0, 0, 1};
+  View<double* [3]> tri_beta;      // β per triangle corner (shared with the contact buffers)
+  View<double*> tri_contact_area;  // A^C_t (m²)
+  View<double* [3]> tri_scratch;   // Γ_t Σ_j β_tj v_j per triangle
+
   FrictionOperator() = default;
   FrictionOperator(const MeshBuffers<MemorySpace>& mesh, View<double*> drag, double c, double c_t = 0)
       : node_drag(drag),
@@ -39,6 +52,30 @@ struct FrictionOperator {
         block_inverse(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::friction::block_inverse"),
                       mesh.n_nodes) {}
 };
+
+// Switches the substrate blocks on; beta and area are read at every update()/apply() (the contact kernel
+// refreshes them each step).
+template <class MemorySpace>
+void enable_substrate_friction(FrictionOperator<MemorySpace>& op,
+                               Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace> beta,
+                               Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> area, double gamma_n,
+                               double gamma_t, Real3 normal) {
+  op.substrate = true;
+  op.gamma_n = gamma_n;
+  op.gamma_t = gamma_t;
+  op.substrate_normal = (1.0 / norm(normal)) * normal;
+  op.tri_beta = beta;
+  op.tri_contact_area = area;
+  op.tri_scratch = Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>("dcm::friction::tri_scratch",
+                                                                               beta.extent(0));
+}
+
+// y = Γ_t u with Γ_t = A [γ_n n̂n̂ᵀ + γ_t (I − n̂n̂ᵀ)].
+KOKKOS_INLINE_FUNCTION Real3 substrate_block_times(Real3 n, double area, double gamma_n, double gamma_t,
+                                                   Real3 u) {
+  const double un = dot(n, u);
+  return area * (gamma_t * u + ((gamma_n - gamma_t) * un) * n);
+}
 
 // Inverse of the symmetric 3×3 matrix (a00, a11, a22, a01, a02, a12), same packing.
 KOKKOS_INLINE_FUNCTION void invert_sym3(const double a[6], double out[6]) {
@@ -84,12 +121,25 @@ void update_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>
   const auto drag = op.node_drag;
   const auto inverse = op.block_inverse;
   const double c = op.dashpot, c_t = op.dashpot_transverse;
+  const bool substrate = op.substrate;
+  const auto tri_offsets = mesh.node_tri_offsets;
+  const auto corners = mesh.node_tri_corners;
+  const auto beta = op.tri_beta;
+  const auto contact_area = op.tri_contact_area;
+  const double gamma_n = op.gamma_n, gamma_t = op.gamma_t;
+  const Real3 sn = op.substrate_normal;
   Kokkos::parallel_for(
       "dcm::friction::block_jacobi", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
         double a[6] = {drag(i), drag(i), drag(i), 0, 0, 0};
         for (int s = offsets(i); s < offsets(i + 1); ++s)
           add_dashpot_block(load3(dir, bonds(s)), c, c_t, 1.0, a);
+        if (substrate)
+          for (int k = tri_offsets(i); k < tri_offsets(i + 1); ++k) {
+            const int t = corners(k) / 3;
+            const double b = beta(t, corners(k) % 3), w = b * b * contact_area(t);
+            if (w > 0) add_dashpot_block(sn, w * gamma_n, w * gamma_t, 1.0, a);  // β² Γ_t
+          }
         double inv[6];
         invert_sym3(a, inv);
         for (int k = 0; k < 6; ++k) inverse(i, k) = inv[k];
@@ -108,6 +158,28 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
   const auto dir = op.bond_dir;
   const auto drag = op.node_drag;
   const double c = op.dashpot, c_t = op.dashpot_transverse;
+  const bool substrate = op.substrate;
+  const auto tri_offsets = mesh.node_tri_offsets;
+  const auto corners = mesh.node_tri_corners;
+  const auto beta = op.tri_beta;
+  const auto scratch = op.tri_scratch;
+  if (substrate) {  // u_t = Γ_t Σ_j β_tj v_j for the triangles in contact
+    const auto tri = mesh.tri;
+    const auto contact_area = op.tri_contact_area;
+    const double gamma_n = op.gamma_n, gamma_t = op.gamma_t;
+    const Real3 sn = op.substrate_normal;
+    Kokkos::parallel_for(
+        "dcm::friction::substrate_triangles", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_tris),
+        KOKKOS_LAMBDA(const int t) {
+          const double area = contact_area(t);
+          Real3 u{0, 0, 0};
+          if (area > 0) {
+            for (int k = 0; k < 3; ++k) u += beta(t, k) * load3(v, tri(t, k));
+            u = substrate_block_times(sn, area, gamma_n, gamma_t, u);
+          }
+          store3(scratch, t, u);
+        });
+  }
   Kokkos::parallel_for(
       "dcm::friction::apply", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
@@ -121,6 +193,11 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
           acc += (c * along) * n;                       // eq. 25: dashpot along the bond
           if (c_t != 0) acc += c_t * (dv - along * n);  // optional transverse part (eq. 32's c (v_i − v_j))
         }
+        if (substrate)
+          for (int k = tri_offsets(i); k < tri_offsets(i + 1); ++k) {
+            const int t = corners(k) / 3;
+            acc += beta(t, corners(k) % 3) * load3(scratch, t);
+          }
         store3(out, i, acc);
       });
 }
