@@ -6,8 +6,9 @@
 //   M = ∫∫ r × p n dA = Σ_edges ∫ H(ρ(θ)) (ê(θ) × n) dθ,  H(ρ) = ∫_0^ρ p(r) r² dr,
 // where each edge (P, Q) of the triangle, projected on the plane, sweeps the sector (C, P, Q) (signed) and
 // ρ(θ) is the distance from C to the edge along ê(θ). The step of p at r = c and the square root at r = a
-// are integrated exactly in r; θ is integrated by 8-point Gauss–Legendre on pieces split where ρ(θ) crosses
-// a and c, so the integrand is smooth on each piece. Same for the contact area with G_A(ρ) = min(ρ, a)²/2.
+// are integrated exactly in r; the sweep is integrated along the edge (detail::polar_sector) by 8-point
+// Gauss–Legendre on pieces split where ρ crosses a and c, so the integrand is smooth on each piece. Same for
+// the contact area with G_A(ρ) = min(ρ, a)²/2.
 #include "core/vec3.hpp"
 #include "kernels/maugis_dugdale.hpp"
 
@@ -56,16 +57,15 @@ KOKKOS_INLINE_FUNCTION double md_radial_moment(const MdState& st, double rho) {
     // Hertz: (p0/a) ∫ r² sqrt(a² − r²) dr
     h += st.p0 / a * (r * (2 * r * r - a * a) * u + a * a * a * a * phi_end) / 8.0;
     const double w = math::sqrt(math::max(st.c * st.c - a * a, 0.0));
-    if (st.sigma0 > 0 && w > 0 && phi_end > 0) {  // Dugdale inside a, r = a sin φ (smooth in φ)
-      double s = 0;
-      for (int i = 0; i < 8; ++i) {
-        double x, wt;
-        gauss_legendre8(i, x, wt);
-        const double phi = 0.5 * phi_end * (x + 1);
-        const double sn = math::sin(phi), cs = math::cos(phi);
-        s += wt * math::atan2(w, a * cs) * sn * sn * cs;
-      }
-      h -= 2.0 / kMdPi * st.sigma0 * a * a * a * 0.5 * phi_end * s;
+    if (st.sigma0 > 0 && w > 0 && phi_end > 0) {
+      // Dugdale inside a: ∫_0^ρ r² atan(w / sqrt(a² − r²)) dr with r = a sin φ, k = w/a, by parts:
+      //   a³ [sin³Φ/3 · atan(k / cos Φ) − (k/3) J(Φ)],  J = ∫ sin⁴φ / (cos²φ + k²) dφ
+      //   J(Φ) = Φ/2 + sin 2Φ/4 − (2 + k²) Φ + (1 + k²)^{3/2}/k · atan(k tan Φ / sqrt(1 + k²)).
+      const double k = w / a, sn = math::sin(phi_end), cs = math::cos(phi_end), q = math::sqrt(1 + k * k);
+      const double kj = k * (phi_end / 2 + sn * cs / 2 - (2 + k * k) * phi_end) +
+                        q * q * q * math::atan2(k * sn, q * cs);  // k · J(Φ)
+      const double d = a * a * a * (sn * sn * sn / 3 * math::atan2(k, cs) - kj / 3);
+      h -= 2.0 / kMdPi * st.sigma0 * d;
     }
   }
   if (rho > a && st.c > a) {
@@ -82,56 +82,57 @@ struct PolarIntegral {
 };
 
 namespace detail {
-// One signed sector (C = origin, P, Q) in plane coordinates.
+// One signed sector (C = origin, P, Q) in plane coordinates, parametrised by the position s along the edge
+// from the foot F of the perpendicular from C: r(s) = F + s d̂, ρ² = h² + s², dθ = κ ds / ρ² with
+// κ = F × d̂ (= ±h). The integrands G(ρ) κ/ρ², H(ρ) κ/ρ³ (sin θ, cos θ) stay bounded and smooth even when C
+// lies on or near the edge's line (where an angle parametrisation is nearly singular); pieces split where
+// ρ = a and ρ = c, 8-point Gauss–Legendre on each.
 KOKKOS_INLINE_FUNCTION void polar_sector(const MdState& st, double px, double py, double qx, double qy,
                                          PolarIntegral& out) {
-  const double cr = px * qy - py * qx, dt = px * qx + py * qy;
-  const double dx = qx - px, dy = qy - py, len2 = dx * dx + dy * dy;
-  if (!(len2 > 0) || cr == 0) return;
-  const double span = math::atan2(cr, dt);  // signed angle from P to Q
-  const double theta_p = math::atan2(py, px);
-  // Distance from C to the line PQ and the direction of its foot (from d, robust when C is near the line).
-  const double len = math::sqrt(len2);
-  const double hdist = math::fabs(cr) / len;
-  const double side = (dy * px - dx * py) >= 0 ? 1.0 : -1.0;
-  const double theta_f = math::atan2(-side * dx, side * dy);
-  // Break points (as offsets s in (0, span) from θ_P) where ρ(θ) = a or c.
+  const double dx = qx - px, dy = qy - py, len = math::sqrt(dx * dx + dy * dy);
+  if (!(len > 0)) return;
+  const double ux = dx / len, uy = dy / len;
+  const double sp = px * ux + py * uy, sq = qx * ux + qy * uy;  // positions of P and Q along the edge
+  const double fx = px - sp * ux, fy = py - sp * uy;            // foot of the perpendicular from C
+  const double kappa = fx * uy - fy * ux;                       // F × d̂, signed distance of the line
+  if (kappa == 0) return;                                       // C on the line: a sector of zero area
+  const double h2 = kappa * kappa;
   double cuts[6];
   int n_cuts = 0;
-  cuts[n_cuts++] = 0;
+  cuts[n_cuts++] = sp;
   const double radii[2] = {st.a, st.c};
   for (int k = 0; k < 2; ++k) {
-    if (!(radii[k] > hdist)) continue;
-    const double phi = math::acos(hdist / radii[k]);
+    if (!(radii[k] * radii[k] > h2)) continue;
+    const double sr = math::sqrt(radii[k] * radii[k] - h2);
     for (int sgn = -1; sgn <= 1; sgn += 2) {
-      double s = theta_f + sgn * phi - theta_p;
-      while (s > kMdPi) s -= 2 * kMdPi;
-      while (s <= -kMdPi) s += 2 * kMdPi;
-      if ((span > 0 && s > 0 && s < span) || (span < 0 && s < 0 && s > span)) cuts[n_cuts++] = s;
+      const double sc = sgn * sr;
+      if ((sc - sp) * (sc - sq) < 0) cuts[n_cuts++] = sc;
     }
   }
-  cuts[n_cuts++] = span;
-  for (int i = 1; i < n_cuts; ++i)  // insertion sort by distance from 0 along the sweep
-    for (int j = i; j > 0 && math::fabs(cuts[j]) < math::fabs(cuts[j - 1]); --j) {
+  cuts[n_cuts++] = sq;
+  const double dir = sq > sp ? 1.0 : -1.0;
+  for (int i = 1; i < n_cuts; ++i)  // insertion sort along the sweep from P to Q
+    for (int j = i; j > 0 && dir * (cuts[j] - cuts[j - 1]) < 0; --j) {
       const double tmp = cuts[j];
       cuts[j] = cuts[j - 1];
       cuts[j - 1] = tmp;
     }
   for (int piece = 0; piece + 1 < n_cuts; ++piece) {
-    const double s0 = cuts[piece], s1 = cuts[piece + 1], half = 0.5 * (s1 - s0);
+    const double s0 = cuts[piece], half = 0.5 * (cuts[piece + 1] - s0);
     if (half == 0) continue;
     for (int i = 0; i < 8; ++i) {
       double x, wt;
       gauss_legendre8(i, x, wt);
-      const double theta = theta_p + s0 + half * (x + 1);
-      const double rho = cr / (math::cos(theta) * dy - math::sin(theta) * dx);  // ray from C meets PQ
-      const double weight = wt * half;
-      const double hm = md_radial_moment(st, rho);
-      out.load += weight * md_radial_load(st, rho);
-      out.m1 += weight * hm * math::sin(theta);  // ê × n = sin θ e1 − cos θ e2
-      out.m2 -= weight * hm * math::cos(theta);
+      const double sv = s0 + half * (x + 1);
+      const double rx = fx + sv * ux, ry = fy + sv * uy;
+      const double rho2 = h2 + sv * sv, rho = math::sqrt(rho2);
+      const double dtheta = wt * half * kappa / rho2;
+      const double hm = md_radial_moment(st, rho) / rho;
+      out.load += dtheta * md_radial_load(st, rho);
+      out.m1 += dtheta * hm * ry;  // ê × n = sin θ e1 − cos θ e2
+      out.m2 -= dtheta * hm * rx;
       const double ra = math::min(rho, st.a);
-      out.contact_area += weight * 0.5 * ra * ra;
+      out.contact_area += dtheta * 0.5 * ra * ra;
     }
   }
 }
