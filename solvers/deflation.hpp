@@ -18,10 +18,10 @@ namespace dcm {
 struct DeflationSettings {
   double volume_fraction = 0.6;  // V_end / V_sphere
   int ramp_steps = 8;            // equilibria on the way down
-  double oblate_seed = 0.97;     // z of the start scaled by this
+  double oblate_seed = 0.8;      // z of the start scaled by this
   double length_scale = 0;       // Newton's step scale (m); 0: 1% of the radius
   double force_tol = 1e-15;      // N, Newton's convergence per ramp step
-  double spring_scale = 0.01;    // bonds' k_s × this during deflation (soft shear: bending shapes the cell)
+  double spring_scale = 0.001;   // bonds' k_s × this during deflation (soft shear: bending shapes the cell)
   bool local_area = false;       // keep the per-triangle area term (off: triangles may change area)
   bool flat_bending = true;      // bending rest angles 0 (no spontaneous curvature) instead of the sphere's
 };

@@ -9,7 +9,8 @@
 // Smoother: ν sweeps of damped block-Jacobi x ← x + ω D⁻¹ (b − A x) before and the same ν after the
 // coarse correction. D is symmetric, so the post-smoother is the adjoint of the pre-smoother and the
 // V-cycle is a symmetric operator; it is positive definite when every smoother is an A-norm contraction
-// (ω λ_max(D⁻¹A) < 2; on level 0 A ≤ 2 D since each dashpot [M −M; −M M] ≤ 2 diag(M, M)) and the
+// (ω λ_max(D⁻¹A) < 2; on level 0 A ≤ 3 D since each dashpot [M −M; −M M] ≤ 2 diag(M, M) and each substrate
+// block ββᵀ ⊗ Γ_t ≤ 3 diag(β²) ⊗ Γ_t; ω = 0.6) and the
 // coarsest solve is exact. Expectations (tests/test_multigrid.cpp): R = Pᵀ, uᵀM⁻¹w = wᵀM⁻¹u, uᵀM⁻¹u > 0,
 // PCG agrees with an Eigen solve, iteration counts nearly independent of the mesh size.
 // Without a hierarchy (a mesh not from make_icosphere/make_evans_fung) `available` is false, `note`
@@ -194,6 +195,17 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
     const auto dir = op.bond_dir;
     const auto drag = op.node_drag;
     const double c = op.dashpot, c_t = op.dashpot_transverse;
+    // Substrate friction blocks β_ti β_tj Γ_t (solvers/friction_operator.hpp) lie on the same pattern: the
+    // corners of a triangle are bond neighbours.
+    const bool substrate = op.substrate;
+    const auto cols = a.cols;
+    const auto tri = mesh.tri;
+    const auto tri_off = mesh.node_tri_offsets;
+    const auto corners = mesh.node_tri_corners;
+    const auto beta = op.tri_beta;
+    const auto contact_area = op.tri_contact_area;
+    const double gamma_n = op.gamma_n, gamma_t = op.gamma_t;
+    const Real3 sn = op.substrate_normal;
     Kokkos::parallel_for(
         "dcm::mg::assemble_fine", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows),
         KOKKOS_LAMBDA(const int i) {
@@ -205,6 +217,19 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
             if (b < 0) blk[0] = blk[1] = blk[2] = drag(i);
             for (int t = first; t < last; ++t) {
               add_dashpot_block(load3(dir, b >= 0 ? b : node_bonds(t)), c, c_t, sign, blk);
+            }
+            if (substrate) {
+              const int j = cols(s);
+              for (int q = tri_off(i); q < tri_off(i + 1); ++q) {
+                const int t = corners(q) / 3;
+                const double area = contact_area(t);
+                if (!(area > 0)) continue;
+                for (int k = 0; k < 3; ++k)
+                  if (tri(t, k) == j) {
+                    const double w = beta(t, corners(q) % 3) * beta(t, k) * area;
+                    add_dashpot_block(sn, w * gamma_n, w * gamma_t, 1.0, blk);
+                  }
+              }
             }
             for (int k = 0; k < 6; ++k) val(s, k) = blk[k];
           }

@@ -63,8 +63,30 @@ struct FrictionSetup {
     apply_friction(Exec(), mesh, op, v, out);
     return out;
   }
+  // Substrate friction on random β (Σ = 1) and contact areas (a third of the triangles), γ_n = 8e9,
+  // γ_t = 6e9 N·s/m³, a tilted plane normal; then update_friction().
+  void enable_random_substrate(unsigned seed) {
+    const int n_tris = mesh.n_tris;
+    Kokkos::View<double* [3], Kokkos::LayoutRight, Mem> beta("beta", n_tris);
+    Kokkos::View<double*, Kokkos::LayoutRight, Mem> area("area", n_tris);
+    auto bh = Kokkos::create_mirror_view(beta);
+    auto ah = Kokkos::create_mirror_view(area);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int t = 0; t < n_tris; ++t) {
+      const double b0 = u(rng), b1 = u(rng), b2 = u(rng), sum = b0 + b1 + b2;
+      bh(t, 0) = b0 / sum;
+      bh(t, 1) = b1 / sum;
+      bh(t, 2) = b2 / sum;
+      ah(t) = t % 3 == 0 ? 1e-13 * u(rng) : 0.0;
+    }
+    Kokkos::deep_copy(beta, bh);
+    Kokkos::deep_copy(area, ah);
+    enable_substrate_friction(op, beta, area, 8e9, 6e9, Real3{0.2, -0.1, 1.0});
+    update_friction(Exec(), mesh, op);
+  }
   // Γ assembled on the host from its definition (independent of the kernels): drag on the diagonal,
-  // c n̂n̂ᵀ blocks coupling the two nodes of every bond.
+  // c n̂n̂ᵀ blocks coupling the two nodes of every bond, and the substrate blocks β_ti β_tj Γ_t if enabled.
   Eigen::MatrixXd assemble() const {
     const int n = mesh.n_nodes;
     const auto x = to_host_vector(mesh.x);
@@ -82,6 +104,18 @@ struct FrictionSetup {
       a.block<3, 3>(3 * j, 3 * j) += nn;
       a.block<3, 3>(3 * i, 3 * j) -= nn;
       a.block<3, 3>(3 * j, 3 * i) -= nn;
+    }
+    if (op.substrate) {
+      const auto tri = to_host_vector(mesh.tri);
+      const auto beta = to_host_vector(op.tri_beta), area = to_host_vector(op.tri_contact_area);
+      const Eigen::Vector3d sn(op.substrate_normal.x, op.substrate_normal.y, op.substrate_normal.z);
+      const Eigen::Matrix3d g =
+          op.gamma_n * sn * sn.transpose() + op.gamma_t * (Eigen::Matrix3d::Identity() - sn * sn.transpose());
+      for (std::size_t t = 0; t < area.size(); ++t)
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            a.block<3, 3>(3 * tri[3 * t + i], 3 * tri[3 * t + j]) +=
+                beta[3 * t + i] * beta[3 * t + j] * area[t] * g;
     }
     return a;
   }

@@ -162,6 +162,29 @@ TEST(Multigrid, PcgAgreesWithEigenReferenceOn642Nodes) {
 
 // Cold start, 1e-6 relative (kept loose so that block-Jacobi at 2562 nodes stays fast): multigrid needs
 // several times fewer iterations than block-Jacobi. Not yet mesh-independent (docs/model/solver.md).
+// With substrate friction blocks (a cell in contact) the V-cycle includes them on level 0: still symmetric
+// positive, and PCG agrees with Eigen.
+TEST(Multigrid, WithSubstrateFrictionPcgAgreesWithEigen) {
+  Preconditioned s({3});
+  s.enable_random_substrate(9);
+  update_multigrid(Exec(), s.mesh, s.op, s.mg);
+  const Eigen::MatrixXd a = s.assemble();
+  const Vector f = s.random_vector(13, 1e-12);
+  const auto fh = to_host_vector(f);
+  const Eigen::VectorXd reference = a.llt().solve(Eigen::Map<const Eigen::VectorXd>(fh.data(), fh.size()));
+  Vector v("v", s.mesh.n_nodes);
+  const CgResult r = s.solve(Preconditioned::Kind::multigrid, f, v, 1e-12);
+  Vector w("w", s.mesh.n_nodes);
+  const CgResult rb = s.solve(Preconditioned::Kind::block_jacobi, f, w, 1e-12);
+  std::printf("  642 nodes with substrate friction: multigrid %d, block-Jacobi %d iterations to 1e-12\n",
+              r.iterations, rb.iterations);
+  ASSERT_TRUE(r.converged);
+  const auto vh = to_host_vector(v);
+  EXPECT_LT((Eigen::Map<const Eigen::VectorXd>(vh.data(), vh.size()) - reference).norm(),
+            1e-8 * reference.norm());
+  EXPECT_LT(r.iterations, rb.iterations);
+}
+
 TEST(Multigrid, IterationsWellBelowBlockJacobi) {
   for (int k = 2; k <= 4; ++k) {
     const Preconditioned s({k});

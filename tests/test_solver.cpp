@@ -65,45 +65,32 @@ TEST(FrictionOperator, MatchesTheAssembledMatrixWhichIsPositiveDefinite) {
 TEST(FrictionOperator, SubstrateBlocksMatchAssemblyAndKeepGammaSymmetricPositive) {
   FrictionSetup s(2);
   const Eigen::MatrixXd without = s.assemble();
-  const int n_tris = s.mesh.n_tris;
-  Kokkos::View<double* [3], Kokkos::LayoutRight, Mem> beta("beta", n_tris);
-  Kokkos::View<double*, Kokkos::LayoutRight, Mem> area("area", n_tris);
-  auto bh = Kokkos::create_mirror_view(beta);
-  auto ah = Kokkos::create_mirror_view(area);
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(0, 1);
-  for (int t = 0; t < n_tris; ++t) {
-    const double b0 = u(rng), b1 = u(rng), b2 = u(rng), sum = b0 + b1 + b2;
-    bh(t, 0) = b0 / sum;
-    bh(t, 1) = b1 / sum;
-    bh(t, 2) = b2 / sum;
-    ah(t) = t % 3 == 0 ? 1e-13 * u(rng) : 0.0;  // a third of the triangles in contact
+  s.enable_random_substrate(5);
+  const Eigen::MatrixXd a = s.assemble();
+  // The substrate blocks from their definition, independently of assemble().
+  {
+    Eigen::MatrixXd b = Eigen::MatrixXd::Zero(a.rows(), a.cols());
+    const auto tri = to_host_vector(s.mesh.tri);
+    const auto beta = to_host_vector(s.op.tri_beta), area = to_host_vector(s.op.tri_contact_area);
+    const Eigen::Vector3d nn = Eigen::Vector3d(0.2, -0.1, 1.0).normalized();
+    const Eigen::Matrix3d gt =
+        8e9 * nn * nn.transpose() + 6e9 * (Eigen::Matrix3d::Identity() - nn * nn.transpose());
+    for (std::size_t t = 0; t < area.size(); ++t)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          b.block<3, 3>(3 * tri[3 * t + i], 3 * tri[3 * t + j]) +=
+              beta[3 * t + i] * beta[3 * t + j] * area[t] * gt;
+    EXPECT_LT((a - without - b).norm(), 1e-14 * a.norm());
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(b, Eigen::EigenvaluesOnly);
+    EXPECT_GT(eig.eigenvalues().minCoeff(), -1e-12 * eig.eigenvalues().maxCoeff()) << "PSD";
+    EXPECT_GT(eig.eigenvalues().maxCoeff(), 0.0) << "the substrate blocks are switched on";
   }
-  Kokkos::deep_copy(beta, bh);
-  Kokkos::deep_copy(area, ah);
-  const double gamma_n = 8e9, gamma_t = 6e9;
-  const Real3 normal{0.2, -0.1, 1.0};
-  enable_substrate_friction(s.op, beta, area, gamma_n, gamma_t, normal);
-  update_friction(Exec(), s.mesh, s.op);
-  // Assembly from the definition.
-  Eigen::MatrixXd a = without;
-  const auto tri = to_host_vector(s.mesh.tri);
-  const Eigen::Vector3d nn = Eigen::Vector3d(normal.x, normal.y, normal.z).normalized();
-  const Eigen::Matrix3d gt =
-      gamma_n * nn * nn.transpose() + gamma_t * (Eigen::Matrix3d::Identity() - nn * nn.transpose());
-  for (int t = 0; t < n_tris; ++t)
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        a.block<3, 3>(3 * tri[3 * t + i], 3 * tri[3 * t + j]) += bh(t, i) * bh(t, j) * ah(t) * gt;
   const Vector v = s.random_vector(31);
   const auto vh = to_host_vector(v), gv = to_host_vector(s.apply(v));
   const Eigen::VectorXd expected = a * Eigen::Map<const Eigen::VectorXd>(vh.data(), vh.size());
   EXPECT_LT((Eigen::Map<const Eigen::VectorXd>(gv.data(), gv.size()) - expected).norm(),
             1e-12 * expected.norm());
   EXPECT_LT((a - a.transpose()).norm(), 1e-14 * a.norm());
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a - without, Eigen::EigenvaluesOnly);
-  EXPECT_GT(eig.eigenvalues().minCoeff(), -1e-12 * eig.eigenvalues().maxCoeff());
-  EXPECT_GT(eig.eigenvalues().maxCoeff(), 0.0) << "the substrate blocks are switched on";
   // PCG (block-Jacobi with the substrate diagonal) against Eigen's dense solve.
   const Vector f = s.random_vector(41, 1e-12);
   const auto fh = to_host_vector(f);
