@@ -119,6 +119,12 @@ std::vector<ParamSpec> make_schema() {
       real_key("body.density_excess_kg_per_m3", "75", -1e4, 1e4, kIncl, "kg/m³",
                "cell density minus medium density (RBC in plasma ≈ 1100 − 1025)"),
 
+      bool_key("contact.plane", "false",
+               "a substrate plane z = contact.plane_z_m with Maugis–Dugdale adhesion and substrate friction"),
+      real_key("contact.plane_z_m", "0", -1e-3, 1e-3, kIncl, "m", "height of the substrate plane"),
+      int_choice_key("contact.quadrature_points", "0", {"0", "1", "3", "7", "16"},
+                     "pressure integration over a triangle: 0 = exact in r (dcm's default), 1/3/7/16 = the "
+                     "paper's point rules (eq. 18)"),
       real_key("contact.W_J_per_m2", "1e-3", 0, 1, kIncl, "J/m²", "work of adhesion"),
       real_key("contact.h0_m", "20e-9", 0, 1e-6, kExcl, "m", "range of adhesion (Dugdale)"),
       real_key("contact.gamma_n_N_s_per_m3", "8e9", 0, 1e15, kIncl, "N·s/m³", "normal substrate friction"),

@@ -23,6 +23,7 @@
 #include "kernels/bending.hpp"
 #include "kernels/external_forces.hpp"
 #include "kernels/fene_pow_bonds.hpp"
+#include "kernels/plane_contact.hpp"
 #include "kernels/volume_constraint.hpp"
 #include "solvers/bending_stiffness.hpp"
 #include "solvers/friction_operator.hpp"
@@ -49,6 +50,12 @@ struct MechanicsParams {
       false;                  // bending's Gauss-Newton stiffness in the solve (solvers/bending_stiffness.hpp)
   double gravity = 0;         // m/s², along −z (paper eq. 32's F_gravity); 0: no gravity term
   double density_excess = 0;  // kg/m³, cell minus medium (buoyant weight Δρ V* g per cell)
+  // A substrate plane with Maugis–Dugdale adhesion (kernels/plane_contact.hpp) and substrate friction
+  // γ_n, γ_t (N·s/m³); no plane: no contact kernel runs.
+  bool has_plane = false;
+  Plane plane;
+  PlaneContactParams contact;
+  double gamma_n = 0, gamma_t = 0;
 };
 
 // Index of the first node with a non-finite component, or -1.
@@ -93,6 +100,12 @@ class CortexModel {
       global_ = GlobalStiffness<Mem>(mesh_, p.k_area_global > 0, p.k_volume > 0);
     if (p.gravity != 0 && p.density_excess != 0) gravity_ = node_weights(cells);
     friction_ = FrictionOperator<Mem>(mesh_, node_drag(cells), p.dashpot, p.dashpot_transverse);
+    if (p.has_plane) {
+      contact_ = ContactBuffers<Mem>(mesh_.n_tris);
+      if (p.gamma_n > 0 || p.gamma_t > 0)
+        enable_substrate_friction(friction_, contact_->tri_beta, contact_->tri_contact_area, p.gamma_n,
+                                  p.gamma_t, p.plane.normal);
+    }
     if (p.multigrid && (p.dashpot > 0 || p.dashpot_transverse > 0)) {
       multigrid_ = make_multigrid(cells, mesh_);
       if (!multigrid_->available) multigrid_.reset();  // no hierarchy: block-Jacobi
@@ -108,6 +121,10 @@ class CortexModel {
   const Vector& external_force() const { return external_; }  // set by the caller; zero at start
   const ExecutionSpace& space() const { return space_; }
   const FrictionOperator<Mem>& friction() const { return friction_; }
+  // Per-triangle contact results of the last compute_forces() (empty without a plane).
+  const std::optional<ContactBuffers<Mem>>& contact() const { return contact_; }
+  double contact_area() const { return contact_ ? total_contact_area(space_, *contact_) : 0.0; }  // Σ A^C_t
+  double contact_load() const { return contact_ ? total_contact_load(space_, *contact_) : 0.0; }  // N
 
   // Scales every cell's rest volume V* (deflation, docs/model/deflation.md); no-op without a volume term.
   void scale_rest_volume(double factor) {
@@ -140,6 +157,10 @@ class CortexModel {
     if (volume_) add_volume_forces(space_, mesh_, geo_, *volume_, params_.k_volume, force_);
     add_external_forces(space_, external_, force_);
     if (gravity_) add_external_forces(space_, *gravity_, force_);
+    if (contact_) {
+      compute_plane_contact(space_, mesh_, geo_, params_.plane, params_.contact, *contact_);
+      add_plane_contact_forces(space_, mesh_, params_.plane, *contact_, force_);
+    }
     const int bad_node = first_non_finite_node(space_, force_);
     if (bad_node >= 0)
       throw NumericalError("non-finite force at node " + std::to_string(bad_node) +
@@ -298,6 +319,10 @@ class CortexModel {
                       add_volume_forces(space_, mesh_, geo_, *volume_, params_.k_volume, scratch);
                     })) != "")
       return t;
+    if (contact_ && (t = check("plane contact", [&] {
+                       add_plane_contact_forces(space_, mesh_, params_.plane, *contact_, scratch);
+                     })) != "")
+      return t;
     return "external force or positions";
   }
 
@@ -323,6 +348,7 @@ class CortexModel {
   std::optional<Multigrid<Mem>> multigrid_;
   std::optional<BendingStiffness<Mem>> bending_stiffness_;
   std::optional<Vector> gravity_;
+  std::optional<ContactBuffers<Mem>> contact_;
   FrictionOperator<Mem> friction_;
   CgWorkspace<Mem> cg_;
 };

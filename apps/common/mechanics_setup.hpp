@@ -30,6 +30,15 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
   p.implicit_bending = scene.get_bool("solver.implicit_bending");
   p.gravity = scene.get_real("body.gravity_m_per_s2");
   p.density_excess = scene.get_real("body.density_excess_kg_per_m3");
+  p.has_plane = scene.get_bool("contact.plane");
+  if (p.has_plane) {
+    p.plane.point = {0, 0, scene.get_real("contact.plane_z_m")};
+    p.contact.material = md_material(scene.get_real("cortex.E_Pa"), scene.get_real("cortex.nu"),
+                                     scene.get_real("contact.W_J_per_m2"), scene.get_real("contact.h0_m"));
+    p.contact.quadrature_points = static_cast<int>(scene.get_int("contact.quadrature_points"));
+    p.gamma_n = scene.get_real("contact.gamma_n_N_s_per_m3");
+    p.gamma_t = scene.get_real("contact.gamma_t_N_s_per_m3");
+  }
   return p;
 }
 
