@@ -62,6 +62,17 @@ JsonObject& JsonObject::add(const std::string& key, const std::vector<double>& v
   return *this;
 }
 
+JsonObject& JsonObject::add(const std::string& key, const std::vector<std::vector<double>>& rows) {
+  std::string text = "[";
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    text += r ? ", [" : "[";
+    for (std::size_t i = 0; i < rows[r].size(); ++i) text += (i ? ", " : "") + json_number(rows[r][i]);
+    text += "]";
+  }
+  members_.emplace_back(key, text + "]");
+  return *this;
+}
+
 std::string JsonObject::str() const {
   std::string out = "{\n";
   for (std::size_t i = 0; i < members_.size(); ++i)
