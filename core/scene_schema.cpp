@@ -130,6 +130,10 @@ std::vector<ParamSpec> make_schema() {
       real_key("contact.gamma_n_N_s_per_m3", "8e9", 0, 1e15, kIncl, "N·s/m³", "normal substrate friction"),
       real_key("contact.gamma_t_N_s_per_m3", "6e9", 0, 1e15, kIncl, "N·s/m³",
                "tangential substrate friction"),
+      real_key(
+          "contact.pin_friction_N_s_per_m", "0", 0, 1, kIncl, "N·s/m",
+          "extra friction on nodes whose triangles all lie fully in the contact (the paper's pinning; 0: "
+          "off)"),
 
       real_key("time.dt_s", "6e-6", 0, 1, kExcl, "s", "time step"),
       real_key("time.t_end_s", "1.2", 0, 1e6, kIncl, "s", "simulated time"),

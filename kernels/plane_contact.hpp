@@ -28,12 +28,13 @@ struct Plane {
 
 struct PlaneContactParams {
   MdMaterial material{};       // K = 4/3 E/(1 − ν²), W, h0
-  int quadrature_points = 16;  // 1, 3, 7 or 16 (the paper's rules, eq. 18); 0: exact polar integration
+  int quadrature_points = 0;   // 0: exact polar integration (dcm); 1, 3, 7 or 16: the paper's rules (eq. 18)
   bool projected_area = true;  // quadrature weights × the triangle's area projected on the plane (else A_t)
 };
 
 // What a triangle's contact is doing (tri_regime).
-enum ContactRegime : int { kNoContact = 0, kGap = 1, kQuadrature = 2, kSmallDisc = 3 };
+// kFullContact: the whole (projected) triangle lies within the contact radius a.
+enum ContactRegime : int { kNoContact = 0, kGap = 1, kQuadrature = 2, kSmallDisc = 3, kFullContact = 4 };
 
 template <class MemorySpace>
 struct ContactBuffers {
@@ -185,7 +186,19 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
         }
         load(t) = Fn;
         contact_area(t) = a_contact;
+        const double projected = 0.5 * math::fabs(dot(cross(x1 - x0, x2 - x0), n));
+        if (a_contact >= (1 - 1e-9) * projected && projected > 0) regime(t) = kFullContact;
       });
+}
+
+// A node all of whose triangles lie fully in the contact (the paper's pinned nodes).
+template <class Offsets, class Corners, class Regime>
+KOKKOS_INLINE_FUNCTION bool node_fully_in_contact(int i, const Offsets& offsets, const Corners& corners,
+                                                  const Regime& regime) {
+  if (offsets(i + 1) == offsets(i)) return false;
+  for (int k = offsets(i); k < offsets(i + 1); ++k)
+    if (regime(corners(k) / 3) != kFullContact) return false;
+  return true;
 }
 
 // Adds the contact forces (along the plane normal) gathered from the triangles' corners to force.

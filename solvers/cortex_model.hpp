@@ -56,6 +56,7 @@ struct MechanicsParams {
   Plane plane;
   PlaneContactParams contact;
   double gamma_n = 0, gamma_t = 0;
+  double pin_friction = 0;  // N·s/m on nodes fully in contact (the paper's pinning); 0: off
 };
 
 // Index of the first node with a non-finite component, or -1.
@@ -102,9 +103,8 @@ class CortexModel {
     friction_ = FrictionOperator<Mem>(mesh_, node_drag(cells), p.dashpot, p.dashpot_transverse);
     if (p.has_plane) {
       contact_ = ContactBuffers<Mem>(mesh_.n_tris);
-      if (p.gamma_n > 0 || p.gamma_t > 0)
-        enable_substrate_friction(friction_, contact_->tri_beta, contact_->tri_contact_area, p.gamma_n,
-                                  p.gamma_t, p.plane.normal);
+      if (p.gamma_n > 0 || p.gamma_t > 0 || p.pin_friction > 0)
+        enable_substrate_friction(friction_, *contact_, p.gamma_n, p.gamma_t, p.plane.normal, p.pin_friction);
     }
     if (p.multigrid && (p.dashpot > 0 || p.dashpot_transverse > 0)) {
       multigrid_ = make_multigrid(cells, mesh_);

@@ -20,6 +20,7 @@
 // vectors; Γ·v for a rigid translation is ζ v; matches an assembled Eigen matrix.
 #include "core/buffers.hpp"
 #include "core/vec3.hpp"
+#include "kernels/plane_contact.hpp"
 
 namespace dcm {
 
@@ -42,6 +43,9 @@ struct FrictionOperator {
   View<double* [3]> tri_beta;      // β per triangle corner (shared with the contact buffers)
   View<double*> tri_contact_area;  // A^C_t (m²)
   View<double* [3]> tri_scratch;   // Γ_t Σ_j β_tj v_j per triangle
+  // Pinning (the paper's option): nodes whose triangles all lie fully in the contact get pin_friction I.
+  double pin_friction = 0;  // N·s/m; 0: off
+  View<int*> tri_regime;    // ContactRegime per triangle (shared with the contact buffers)
 
   FrictionOperator() = default;
   FrictionOperator(const MeshBuffers<MemorySpace>& mesh, View<double*> drag, double c, double c_t = 0)
@@ -68,6 +72,16 @@ void enable_substrate_friction(FrictionOperator<MemorySpace>& op,
   op.tri_contact_area = area;
   op.tri_scratch = Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>("dcm::friction::tri_scratch",
                                                                                beta.extent(0));
+}
+
+// The same from the contact buffers of kernels/plane_contact.hpp; pin_friction > 0 also pins the nodes whose
+// triangles all lie fully in the contact (their regime, refreshed by the contact kernel each step).
+template <class MemorySpace>
+void enable_substrate_friction(FrictionOperator<MemorySpace>& op, const ContactBuffers<MemorySpace>& contact,
+                               double gamma_n, double gamma_t, Real3 normal, double pin_friction = 0) {
+  enable_substrate_friction(op, contact.tri_beta, contact.tri_contact_area, gamma_n, gamma_t, normal);
+  op.pin_friction = pin_friction;
+  op.tri_regime = contact.tri_regime;
 }
 
 // y = Γ_t u with Γ_t = A [γ_n n̂n̂ᵀ + γ_t (I − n̂n̂ᵀ)].
@@ -128,6 +142,8 @@ void update_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>
   const auto contact_area = op.tri_contact_area;
   const double gamma_n = op.gamma_n, gamma_t = op.gamma_t;
   const Real3 sn = op.substrate_normal;
+  const double pin = op.pin_friction;
+  const auto regime = op.tri_regime;
   Kokkos::parallel_for(
       "dcm::friction::block_jacobi", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
@@ -140,6 +156,11 @@ void update_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>
             const double b = beta(t, corners(k) % 3), w = b * b * contact_area(t);
             if (w > 0) add_dashpot_block(sn, w * gamma_n, w * gamma_t, 1.0, a);  // β² Γ_t
           }
+        if (pin > 0 && node_fully_in_contact(i, tri_offsets, corners, regime)) {
+          a[0] += pin;
+          a[1] += pin;
+          a[2] += pin;
+        }
         double inv[6];
         invert_sym3(a, inv);
         for (int k = 0; k < 6; ++k) inverse(i, k) = inv[k];
@@ -163,6 +184,8 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
   const auto corners = mesh.node_tri_corners;
   const auto beta = op.tri_beta;
   const auto scratch = op.tri_scratch;
+  const double pin = op.pin_friction;
+  const auto regime = op.tri_regime;
   if (substrate) {  // u_t = Γ_t Σ_j β_tj v_j for the triangles in contact
     const auto tri = mesh.tri;
     const auto contact_area = op.tri_contact_area;
@@ -198,6 +221,7 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
             const int t = corners(k) / 3;
             acc += beta(t, corners(k) % 3) * load3(scratch, t);
           }
+        if (pin > 0 && node_fully_in_contact(i, tri_offsets, corners, regime)) acc += pin * vi;
         store3(out, i, acc);
       });
 }

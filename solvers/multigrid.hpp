@@ -206,6 +206,8 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
     const auto contact_area = op.tri_contact_area;
     const double gamma_n = op.gamma_n, gamma_t = op.gamma_t;
     const Real3 sn = op.substrate_normal;
+    const double pin = op.pin_friction;
+    const auto regime = op.tri_regime;
     Kokkos::parallel_for(
         "dcm::mg::assemble_fine", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows),
         KOKKOS_LAMBDA(const int i) {
@@ -215,6 +217,11 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
             const int first = b >= 0 ? 0 : node_off(i), last = b >= 0 ? 1 : node_off(i + 1);
             const double sign = b >= 0 ? -1.0 : 1.0;
             if (b < 0) blk[0] = blk[1] = blk[2] = drag(i);
+            if (b < 0 && pin > 0 && node_fully_in_contact(i, tri_off, corners, regime)) {
+              blk[0] += pin;
+              blk[1] += pin;
+              blk[2] += pin;
+            }
             for (int t = first; t < last; ++t) {
               add_dashpot_block(load3(dir, b >= 0 ? b : node_bonds(t)), c, c_t, sign, blk);
             }

@@ -305,5 +305,62 @@ TEST(CortexModel, GravityGivesTheStokesSedimentationVelocity) {
   EXPECT_NEAR(model.energy() - e0, -weight * stokes * 1e-3, 1e-6 * weight * stokes * 1e-3);
 }
 
+// A cell on an adhesive plane: at rest shape, the only force is the contact, its node sum equals the
+// triangles' total load and that of the perfect sphere (attractive at a small overlap); the contact area is
+// the perfect sphere's; the solve with substrate friction converges and the cell moves towards the plane.
+// Pressed deeper, nodes fully in contact are pinned: Γ's diagonal carries the pin friction there.
+MechanicsParams on_plane(double r, double a) {
+  MechanicsParams p = table1();
+  p.has_plane = true;
+  p.plane.point = {0, 0, -r + (r - std::sqrt(r * r - a * a))};  // the sphere's bottom overlaps the plane
+  p.contact.material = md_material(800e3, 0.4, 1e-3, 20e-9);
+  p.gamma_n = 8e9;
+  p.gamma_t = 6e9;
+  p.pin_friction = 1e-3;
+  return p;
+}
+
+TEST(CortexModel, CellOnAnAdhesivePlane) {
+  const double r = 3.25e-6, a = 0.2e-6, pi = 3.14159265358979323846;
+  const MechanicsParams p = on_plane(r, a);
+  CortexModel<Exec> model(Exec(), {HostCell(make_icosphere(4, r))}, p);
+  model.compute_forces();
+  const auto f = to_host_vector(model.force());
+  double fz = 0;
+  for (std::size_t i = 2; i < f.size(); i += 3) fz += f[i];
+  EXPECT_NEAR(fz, model.contact_load(), 1e-9 * std::fabs(model.contact_load()));
+  const MdState exact = md_state_from_radius(a, r, p.contact.material);
+  EXPECT_LT(exact.P, 0.0) << "adhesive at this overlap";
+  EXPECT_NEAR(model.contact_load(), exact.P, 1e-3 * std::fabs(exact.P));
+  EXPECT_NEAR(std::sqrt(model.contact_area() / pi), a, 1e-3 * a);
+  CgSettings cg;
+  cg.abs_tol = 0;
+  cg.rel_tol = 1e-10;
+  EXPECT_TRUE(model.solve_velocity(cg, 6e-6).converged);
+  const auto v = to_host_vector(model.velocity());
+  double vz = 0;
+  for (std::size_t i = 2; i < v.size(); i += 3) vz += v[i];
+  EXPECT_LT(vz, 0.0) << "pulled towards the plane";
+
+  CortexModel<Exec> pressed(Exec(), {HostCell(make_icosphere(4, r))}, on_plane(r, 1.0e-6));
+  pressed.compute_forces();
+  EXPECT_TRUE(pressed.solve_velocity(cg, 6e-6).converged);
+  const auto regime = to_host_vector(pressed.contact()->tri_regime);
+  const MeshBuffers<Exec::memory_space>& mesh = pressed.mesh();
+  const auto offsets = to_host_vector(mesh.node_tri_offsets), corners = to_host_vector(mesh.node_tri_corners);
+  int pinned = 0;
+  for (int i = 0; i < mesh.n_nodes; ++i) {
+    bool all = true;
+    for (int k = offsets[i]; k < offsets[i + 1]; ++k) all = all && regime[corners[k] / 3] == kFullContact;
+    if (!all) continue;
+    ++pinned;
+    FrictionOperator<Exec::memory_space>::Vector e("e", mesh.n_nodes), out("out", mesh.n_nodes);
+    Kokkos::deep_copy(Kokkos::subview(e, i, 0), 1.0);
+    apply_friction(Exec(), mesh, pressed.friction(), e, out);
+    EXPECT_GE(to_host_vector(out)[3 * i], 1e-3) << "node " << i;
+  }
+  EXPECT_GT(pinned, 0);
+}
+
 }  // namespace
 }  // namespace dcm

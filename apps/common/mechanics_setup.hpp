@@ -38,6 +38,7 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
     p.contact.quadrature_points = static_cast<int>(scene.get_int("contact.quadrature_points"));
     p.gamma_n = scene.get_real("contact.gamma_n_N_s_per_m3");
     p.gamma_t = scene.get_real("contact.gamma_t_N_s_per_m3");
+    p.pin_friction = scene.get_real("contact.pin_friction_N_s_per_m");
   }
   return p;
 }
