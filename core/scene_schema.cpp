@@ -78,12 +78,9 @@ std::vector<ParamSpec> make_schema() {
   return {
       string_key("name", "", {}, "run name; output goes to out/<name> unless output.dir is set"),
 
-      string_key("mesh.shape", "sphere", {"sphere", "evans_fung", "deflated"},
+      string_key("mesh.shape", "sphere", {"sphere", "evans_fung"},
                  "sphere = icosphere of radius mesh.radius_m; evans_fung = Evans–Fung biconcave RBC of "
-                 "diameter mesh.diameter_m; deflated = the sphere deflated to mesh.deflated_volume_fraction "
-                 "of its volume and relaxed with the cortex constants (the paper's biconcave start)"),
-      real_key("mesh.deflated_volume_fraction", "0.6", 0.3, 1, kIncl, "",
-               "volume of the deflated cell over the sphere's (mesh.shape = deflated)"),
+                 "diameter mesh.diameter_m"),
       int_key("mesh.subdivisions", "4", 0, 6,
               "icosphere subdivisions: 0..6 give 12, 42, 162, 642, 2562, 10242, 40962 nodes"),
       int_choice_key("mesh.nodes", "2562", {"12", "42", "162", "642", "2562", "10242", "40962"},

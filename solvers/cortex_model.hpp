@@ -126,20 +126,6 @@ class CortexModel {
   double contact_area() const { return contact_ ? total_contact_area(space_, *contact_) : 0.0; }  // Σ A^C_t
   double contact_load() const { return contact_ ? total_contact_load(space_, *contact_) : 0.0; }  // N
 
-  // Scales every cell's rest volume V* (deflation, docs/model/deflation.md); no-op without a volume term.
-  void scale_rest_volume(double factor) {
-    if (!volume_) return;
-    const auto v = volume_->cell_volume;
-    Kokkos::parallel_for(
-        "dcm::model::scale_rest_volume", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, v.extent(0)),
-        KOKKOS_LAMBDA(const int c) { v(c) *= factor; });
-  }
-
-  // Sets every hinge's rest angle θ* to 0 (bending without spontaneous curvature; deflation).
-  void flatten_bending_rest() {
-    if (hinges_) Kokkos::deep_copy(space_, hinges_->theta_rest, 0.0);
-  }
-
   // Geometry, then the total force on every node.
   void compute_forces() {
     update_geometry(space_, mesh_, geo_, params_.h_min);

@@ -75,7 +75,7 @@ void expect_same_values(const Scene& a, const Scene& b) {
 
 TEST(SceneSchema, KeysAreUniqueAndDefaultsLieInTheirRange) {
   const auto& schema = scene_schema();
-  ASSERT_EQ(schema.size(), 31u);
+  ASSERT_EQ(schema.size(), 37u);
   for (size_t i = 0; i < schema.size(); ++i) {
     for (size_t j = i + 1; j < schema.size(); ++j) EXPECT_NE(schema[i].key, schema[j].key);
     EXPECT_FALSE(schema[i].doc.empty()) << schema[i].key;
@@ -266,7 +266,8 @@ TEST(SceneParse, UnknownTable) {
   const std::string msg = string_error("[integrator]\ntolerance = 1e-9\n");
   expect_one_line(msg);
   EXPECT_TRUE(contains(msg, "unknown key 'integrator.tolerance'")) << msg;
-  EXPECT_TRUE(contains(msg, "known tables: mesh, geometry, cortex, fluid, contact, time, solver, output"))
+  EXPECT_TRUE(
+      contains(msg, "known tables: mesh, geometry, cortex, fluid, body, contact, time, solver, output"))
       << msg;
   const std::string empty = string_error("[integrator]\n");
   EXPECT_TRUE(contains(empty, "unknown table [integrator]")) << empty;
@@ -502,7 +503,7 @@ TEST(SceneSchemaMarkdown, OneTablePerSection) {
        ++pos) {
     ++headers;
   }
-  EXPECT_EQ(headers, 9u);  // top level + 8 tables
+  EXPECT_EQ(headers, 10u);  // top level + 9 tables
   EXPECT_TRUE(contains(md, "| `mesh.subdivisions` | integer | `4` | 0 .. 6 |")) << md;
   EXPECT_TRUE(contains(md, "| `mesh.radius_m` | real | `3.25e-6` | > 0 and ≤ 0.001 | m |")) << md;
   EXPECT_TRUE(contains(md, "| `mesh.shape` | string | `\"sphere\"` | sphere, evans_fung |")) << md;

@@ -7,7 +7,6 @@
 #include "core/host_mesh.hpp"
 #include "core/scene.hpp"
 #include "solvers/cortex_model.hpp"
-#include "solvers/deflation.hpp"
 
 namespace dcm {
 
@@ -43,23 +42,15 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
   return p;
 }
 
-// The cell's start shape (mesh.shape). Kokkos must be initialised: "deflated" relaxes the sphere with the
-// scene's cortex constants (solvers/deflation.hpp) on the default execution space.
+// The cell's start shape (mesh.shape).
 inline HostMesh cell_mesh_from_scene(const Scene& scene) {
   const int k = static_cast<int>(scene.get_int("mesh.subdivisions"));
-  const std::string shape = scene.get_string("mesh.shape");
-  if (shape == "evans_fung") {
+  if (scene.get_string("mesh.shape") == "evans_fung") {
     EvansFungShape ef;
     ef.diameter = scene.get_real("mesh.diameter_m");
     return make_evans_fung(k, ef);
   }
-  HostMesh sphere = make_icosphere(k, scene.get_real("mesh.radius_m"));
-  if (shape == "deflated") {
-    DeflationSettings s;
-    s.volume_fraction = scene.get_real("mesh.deflated_volume_fraction");
-    return deflate_sphere(Kokkos::DefaultExecutionSpace(), sphere, mechanics_from_scene(scene), s).mesh;
-  }
-  return sphere;
+  return make_icosphere(k, scene.get_real("mesh.radius_m"));
 }
 
 inline CgSettings cg_settings_from_scene(const Scene& scene) {
