@@ -51,6 +51,10 @@ JsonObject& JsonObject::add(const std::string& key, long long value) {
   members_.emplace_back(key, std::to_string(value));
   return *this;
 }
+JsonObject& JsonObject::add(const std::string& key, bool value) {
+  members_.emplace_back(key, value ? "true" : "false");
+  return *this;
+}
 JsonObject& JsonObject::add(const std::string& key, const std::string& value) {
   members_.emplace_back(key, json_string(value));
   return *this;

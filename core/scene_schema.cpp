@@ -122,6 +122,8 @@ std::vector<ParamSpec> make_schema() {
       int_choice_key("contact.quadrature_points", "0", {"0", "1", "3", "7", "16"},
                      "pressure integration over a triangle: 0 = exact in r (dcm's default), 1/3/7/16 = the "
                      "paper's point rules (eq. 18)"),
+      real_key("contact.start_gap_m", "10e-9", 0, 1e-6, kIncl, "m",
+               "spread: the cell's lowest node starts this far above the plane (below contact.h0_m)"),
       real_key("contact.W_J_per_m2", "1e-3", 0, 1, kIncl, "J/m²", "work of adhesion"),
       real_key("contact.h0_m", "20e-9", 0, 1e-6, kExcl, "m", "range of adhesion (Dugdale)"),
       real_key("contact.gamma_n_N_s_per_m3", "8e9", 0, 1e15, kIncl, "N·s/m³", "normal substrate friction"),
@@ -151,6 +153,10 @@ std::vector<ParamSpec> make_schema() {
 
       string_key("output.dir", "", {}, "output directory (empty: out/<name>)"),
       bool_key("output.hdf5", "true", "write the HDF5 + XDMF output"),
+      real_key("output.frame_every_s", "0.05", 0, 1e6, kExcl, "s",
+               "simulated time between HDF5 frames (spread also writes t = 0.1, 0.35, 0.9 s and the end)"),
+      int_key("output.series_per_decade", "40", 1, 10000,
+              "rows of series.csv per decade of simulated time (log-spaced; every step for the first ten)"),
   };
 }
 

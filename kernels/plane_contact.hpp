@@ -30,6 +30,9 @@ struct PlaneContactParams {
   MdMaterial material{};       // K = 4/3 E/(1 − ν²), W, h0
   int quadrature_points = 0;   // 0: exact polar integration (dcm); 1, 3, 7 or 16: the paper's rules (eq. 18)
   bool projected_area = true;  // quadrature weights × the triangle's area projected on the plane (else A_t)
+  // Substrate friction acts on the triangle's area within r < max(a, c) (contact and adhesive zone; dcm's
+  // default, docs/model/contact.md) or, as the paper writes, within the contact radius a only.
+  bool friction_on_adhesive_zone = true;
 };
 
 // What a triangle's contact is doing (tri_regime).
@@ -43,6 +46,7 @@ struct ContactBuffers {
   View<double* [3]> tri_node_load;  // normal force on each corner's node (N), along the plane normal
   View<double* [3]> tri_beta;       // friction weights β of each corner (Σ = 1)
   View<double*> tri_contact_area;   // A^C_t, the part of the triangle inside the contact radius a (m²)
+  View<double*> tri_friction_area;  // the area the substrate friction acts on (m²): A^C_t or the zone r < c
   View<double*> tri_load;           // F_t · n (N), repulsive positive
   View<int*> tri_regime;            // ContactRegime
 
@@ -51,6 +55,7 @@ struct ContactBuffers {
       : tri_node_load("dcm::contact::tri_node_load", n_tris),
         tri_beta("dcm::contact::tri_beta", n_tris),
         tri_contact_area("dcm::contact::tri_contact_area", n_tris),
+        tri_friction_area("dcm::contact::tri_friction_area", n_tris),
         tri_load("dcm::contact::tri_load", n_tris),
         tri_regime("dcm::contact::tri_regime", n_tris) {}
 };
@@ -111,6 +116,7 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
   const auto node_load = out.tri_node_load;
   const auto beta = out.tri_beta;
   const auto contact_area = out.tri_contact_area;
+  const auto friction_area = out.tri_friction_area;
   const auto load = out.tri_load;
   const auto regime = out.tri_regime;
   const double len = norm(plane.normal);
@@ -124,6 +130,7 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
           beta(t, k) = 0;
         }
         contact_area(t) = 0;
+        friction_area(t) = 0;
         load(t) = 0;
         regime(t) = kNoContact;
         const Real3 x0 = load3(x, tri(t, 0)), x1 = load3(x, tri(t, 1)), x2 = load3(x, tri(t, 2));
@@ -144,7 +151,7 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
         const Real3 C = O - height * n;
         const double area_t = tri_area(t);
         const double area_q = prm.projected_area ? 0.5 * math::fabs(dot(cross(x1 - x0, x2 - x0), n)) : area_t;
-        double Fn = 0, a_contact = 0;
+        double Fn = 0, a_contact = 0, a_zone = 0;
         Real3 M{0, 0, 0}, C_apply = C;
         const int nq = prm.quadrature_points;
         if (nq == 0) {  // exact in r, Gauss in θ (kernels/polar_contact_integral.hpp); no regimes needed
@@ -156,19 +163,22 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
           Fn = pi.load;
           M = pi.m1 * e1 + pi.m2 * e2;
           a_contact = pi.contact_area;
+          a_zone = pi.zone_area;
           regime(t) = st.a > 0 ? kQuadrature : kGap;
         } else if (kMdPi * outer * outer * nq >= 2.0 * area_t) {  // eq. 18, regime 1: quadrature (eqs. 16–17)
           integrate_pressure(
               x0, x1, x2, C, n, area_q, nq, [&](Real3 r) { return md_pressure(st, norm(r)); }, Fn, M);
-          double inside = 0;
+          double inside = 0, in_zone = 0;
           for (int q = 0; q < nq; ++q) {
             double l1, l2, l3, w;
             quadrature_point(nq, q, l1, l2, l3, w);
             const Real3 rel = l1 * x0 + l2 * x1 + l3 * x2 - C;
             const Real3 r = rel - dot(rel, n) * n;
             if (norm2(r) < st.a * st.a) inside += w;
+            if (norm2(r) < outer * outer) in_zone += w;
           }
           a_contact = inside * area_q;
+          a_zone = in_zone * area_q;
           regime(t) = st.a > 0 ? kQuadrature : kGap;
         } else {  // regime 2: the disc's share of the net load, at C or the triangle's nearest point
           const Real3 q0 = x0 - dot(x0 - C, n) * n, q1 = x1 - dot(x1 - C, n) * n,
@@ -176,6 +186,7 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
           const double fraction = disc_fraction_in_triangle(q0, q1, q2, C, n, outer);
           Fn = fraction * st.P;
           a_contact = fraction * kMdPi * st.a * st.a;
+          a_zone = fraction * kMdPi * outer * outer;
           C_apply = nearest_point_in_triangle(q0, q1, q2, C, n);
           regime(t) = st.a > 0 ? kSmallDisc : kGap;
         }
@@ -186,6 +197,7 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
         }
         load(t) = Fn;
         contact_area(t) = a_contact;
+        friction_area(t) = prm.friction_on_adhesive_zone ? a_zone : a_contact;
         const double projected = 0.5 * math::fabs(dot(cross(x1 - x0, x2 - x0), n));
         if (a_contact >= (1 - 1e-9) * projected && projected > 0) regime(t) = kFullContact;
       });

@@ -79,6 +79,7 @@ struct PolarIntegral {
   double load = 0;          // ∫ p dA (N)
   double m1 = 0, m2 = 0;    // moment about C in the basis (e1, e2) of the plane (N·m)
   double contact_area = 0;  // area of the triangle within r < a (m²)
+  double zone_area = 0;     // area of the triangle within r < max(a, c), contact and adhesive zone (m²)
 };
 
 namespace detail {
@@ -133,6 +134,8 @@ KOKKOS_INLINE_FUNCTION void polar_sector(const MdState& st, double px, double py
       out.m2 -= dtheta * hm * rx;
       const double ra = math::min(rho, st.a);
       out.contact_area += dtheta * 0.5 * ra * ra;
+      const double rz = math::min(rho, math::max(st.a, st.c));
+      out.zone_area += dtheta * 0.5 * rz * rz;
     }
   }
 }
@@ -156,6 +159,7 @@ KOKKOS_INLINE_FUNCTION PolarIntegral polar_contact_integral(const MdState& st, R
     out.m1 = -out.m1;
     out.m2 = -out.m2;
     out.contact_area = -out.contact_area;
+    out.zone_area = -out.zone_area;
   }
   return out;
 }

@@ -21,6 +21,7 @@
 #include "core/update_geometry.hpp"
 #include "kernels/area_constraints.hpp"
 #include "kernels/bending.hpp"
+#include "kernels/cortex_diagnostics.hpp"
 #include "kernels/external_forces.hpp"
 #include "kernels/fene_pow_bonds.hpp"
 #include "kernels/plane_contact.hpp"
@@ -123,6 +124,16 @@ class CortexModel {
   const FrictionOperator<Mem>& friction() const { return friction_; }
   // Per-triangle contact results of the last compute_forces() (empty without a plane).
   const std::optional<ContactBuffers<Mem>>& contact() const { return contact_; }
+  // Per-node tension (eq. 1), stretch, normal force and pressure of the current state (compute_forces()
+  // first); needs the bond term.
+  void node_fields(const NodeFields<Mem>& out) const {
+    if (!bonds_) throw std::logic_error("node_fields() needs the FENE+POW bond term");
+    compute_node_fields(space_, mesh_, geo_, *bonds_, params_.bonds, force_, out);
+  }
+  // Power of the contact forces at the current velocity (W); 0 without a plane.
+  double contact_power() const {
+    return contact_ ? dcm::contact_power(space_, mesh_, params_.plane, *contact_, velocity_) : 0.0;
+  }
   double contact_area() const { return contact_ ? total_contact_area(space_, *contact_) : 0.0; }  // Σ A^C_t
   double contact_load() const { return contact_ ? total_contact_load(space_, *contact_) : 0.0; }  // N
 

@@ -41,7 +41,7 @@ struct FrictionOperator {
   double gamma_n = 0, gamma_t = 0;  // N·s/m³
   Real3 substrate_normal{0, 0, 1};
   View<double* [3]> tri_beta;      // β per triangle corner (shared with the contact buffers)
-  View<double*> tri_contact_area;  // A^C_t (m²)
+  View<double*> tri_contact_area;  // the area each triangle's friction acts on (m²)
   View<double* [3]> tri_scratch;   // Γ_t Σ_j β_tj v_j per triangle
   // Pinning (the paper's option): nodes whose triangles all lie fully in the contact get pin_friction I.
   double pin_friction = 0;  // N·s/m; 0: off
@@ -79,7 +79,7 @@ void enable_substrate_friction(FrictionOperator<MemorySpace>& op,
 template <class MemorySpace>
 void enable_substrate_friction(FrictionOperator<MemorySpace>& op, const ContactBuffers<MemorySpace>& contact,
                                double gamma_n, double gamma_t, Real3 normal, double pin_friction = 0) {
-  enable_substrate_friction(op, contact.tri_beta, contact.tri_contact_area, gamma_n, gamma_t, normal);
+  enable_substrate_friction(op, contact.tri_beta, contact.tri_friction_area, gamma_n, gamma_t, normal);
   op.pin_friction = pin_friction;
   op.tri_regime = contact.tri_regime;
 }

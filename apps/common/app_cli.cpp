@@ -85,6 +85,9 @@ int run_app(CLI::App& app, int argc, char** argv, const std::function<void()>& b
   } catch (const NumericalError& e) {
     std::cerr << name << ": numerical failure: " << e.what() << '\n';
     return 3;
+  } catch (const AppInterrupted& e) {
+    std::cerr << name << ": " << e.what() << '\n';
+    return 130;
   } catch (const std::exception& e) {
     std::cerr << name << ": internal error: " << e.what() << '\n';
     return 1;

@@ -7,6 +7,7 @@
 //   1  anything else (a bug: please report it).
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,11 @@
 #include "core/scene.hpp"
 
 namespace dcm {
+
+// Thrown by an app that stopped on SIGINT/SIGTERM after closing its files; run_app returns 130.
+struct AppInterrupted : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 struct AppOptions {
   std::string scene_path;         // empty: the built-in defaults

@@ -1,0 +1,312 @@
+// spread: the paper's cell-spreading experiment (its Figures 1, 4–6). A cell placed just above an adhesive
+// plane (its lowest node contact.start_gap_m above it, within the range h0) spreads under the overdamped
+// dynamics Γ v = F (paper eqs. 30–32): Maugis–Dugdale adhesion of the rounded triangles, substrate friction,
+// the cortex terms and dashpots of the scene. Writes to <out>/:
+//   series.csv   t_s,r_cc_m,contact_area_m2,area_m2,volume_m3,cg_iterations,dt_s,height_m,contact_load_N,
+//                elastic_energy_J,dE_dt_W,contact_power_W,dissipation_W,energy_residual_W
+//                (log-spaced in time: output.series_per_decade rows per decade, and every step at the start)
+//   spread.h5/.xmf  mesh, series, frames (every output.frame_every_s and at t = 0.1, 0.35, 0.9 s) with the
+//                per-node normal force and pressure, cortex tension (eq. 1) and stretch
+//   summary.json r_cc_final_m, contact_angle_deg, early_exponent (+ window), height_final_m, steps, wall_s,
+//                mean_cg_iterations, energy balance, ...
+//   r_cc.png, cells.png, side_views.png (scripts/plot_spread.py) unless --no-plot
+// Ctrl-C (SIGINT) or SIGTERM: the loop stops after the current step, the files are closed and valid, the
+// summary says "interrupted": true; exit code 130.
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "apps/common/app_cli.hpp"
+#include "apps/common/mechanics_setup.hpp"
+#include "core/h5_output.hpp"
+#include "core/host_copy.hpp"
+#include "core/json_writer.hpp"
+#include "core/kokkos_compat.hpp"
+
+namespace dcm {
+namespace {
+
+using Exec = Kokkos::DefaultExecutionSpace;
+constexpr double kPi = 3.14159265358979323846;
+
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_signal(int) { g_stop = 1; }
+
+struct SpreadOptions {
+  bool plot = true;
+  double early_from_s = 2e-3, early_to_s = 5e-2;  // window of the early power-law fit
+};
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Sphere through the top 95% of the nodes (by height above the plane), algebraic least squares
+// |x|² = 2 c·x + d; the contact angle from the centre's height h_c above the plane: θ = π − acos(h_c / R).
+struct CapFit {
+  double radius = NAN, centre_height = NAN, angle_deg = NAN;
+};
+CapFit fit_cap(const std::vector<double>& x, double plane_z) {
+  const int n = static_cast<int>(x.size() / 3);
+  std::vector<double> z(n);
+  for (int i = 0; i < n; ++i) z[i] = x[3 * i + 2];
+  std::vector<double> sorted = z;
+  std::sort(sorted.begin(), sorted.end());
+  const double cut = sorted[static_cast<std::size_t>(0.05 * (n - 1))];
+  Eigen::MatrixXd a(n, 4);
+  Eigen::VectorXd b(n);
+  int m = 0;
+  for (int i = 0; i < n; ++i) {
+    if (z[i] < cut) continue;
+    a.row(m) << 2 * x[3 * i], 2 * x[3 * i + 1], 2 * x[3 * i + 2], 1.0;
+    b(m) = x[3 * i] * x[3 * i] + x[3 * i + 1] * x[3 * i + 1] + x[3 * i + 2] * x[3 * i + 2];
+    ++m;
+  }
+  const Eigen::Vector4d s = a.topRows(m).colPivHouseholderQr().solve(b.head(m));
+  CapFit f;
+  f.radius = std::sqrt(s(3) + s(0) * s(0) + s(1) * s(1) + s(2) * s(2));
+  f.centre_height = s(2) - plane_z;
+  f.angle_deg = (kPi - std::acos(std::clamp(f.centre_height / f.radius, -1.0, 1.0))) * 180 / kPi;
+  return f;
+}
+
+// Least-squares slope of log r against log t over the rows with from ≤ t ≤ to and r > 0.
+double fit_exponent(const std::vector<double>& t, const std::vector<double>& r, double from, double to,
+                    int& used) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  used = 0;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (t[i] < from || t[i] > to || !(r[i] > 0)) continue;
+    const double lx = std::log(t[i]), ly = std::log(r[i]);
+    sx += lx;
+    sy += ly;
+    sxx += lx * lx;
+    sxy += lx * ly;
+    ++used;
+  }
+  if (used < 3) return NAN;
+  return (used * sxy - sx * sy) / (used * sxx - sx * sx);
+}
+
+void run(const AppOptions& options, const SpreadOptions& so) {
+  const Scene scene = load_scene(options, {"name=spread", "contact.plane=true"});
+  if (!scene.get_bool("contact.plane"))
+    throw SceneError("contact.plane = false: spread needs the substrate plane (set contact.plane = true)");
+  if (!(so.early_from_s > 0 && so.early_to_s > so.early_from_s))
+    throw SceneError("--early-window-s = " + std::to_string(so.early_from_s) + "," +
+                     std::to_string(so.early_to_s) + " is not allowed: need 0 < from < to");
+  const double h0 = scene.get_real("contact.h0_m"), gap = scene.get_real("contact.start_gap_m");
+  if (!(gap < h0))
+    throw SceneError("contact.start_gap_m = " + std::to_string(gap) +
+                     " is not allowed: it must be below contact.h0_m = " + std::to_string(h0) +
+                     " (the cell starts within the range of adhesion)");
+  const std::string out = prepare_output_dir(options, scene);
+  KokkosSession kokkos(options.threads);
+  const auto wall0 = std::chrono::steady_clock::now();
+
+  // The cell, its lowest node `gap` above the plane.
+  HostMesh mesh = cell_mesh_from_scene(scene);
+  const double plane_z = scene.get_real("contact.plane_z_m");
+  double zmin = INFINITY;
+  for (const auto& x : mesh.nodes) zmin = std::min(zmin, x[2]);
+  for (auto& x : mesh.nodes) x[2] += plane_z + gap - zmin;
+  const MechanicsParams params = mechanics_from_scene(scene);
+  CortexModel<Exec> model(Exec(), {HostCell(mesh)}, params);
+  const int n = model.mesh().n_nodes;
+  NodeFields<Exec::memory_space> fields(n);
+
+  const double dt = scene.get_real("time.dt_s"), t_end = scene.get_real("time.t_end_s");
+  const long long steps = std::llround(t_end / dt);
+  const double frame_every = scene.get_real("output.frame_every_s");
+  const double per_decade = static_cast<double>(scene.get_int("output.series_per_decade"));
+  const CgSettings cg = cg_settings_from_scene(scene);
+
+  std::vector<int> tri, node_cell(n, 0);
+  for (const Tri& t : mesh.triangles) tri.insert(tri.end(), t.begin(), t.end());
+  H5Output h5(out + "/spread.h5");
+  h5.write_text("scene", scene.to_toml());
+  h5.write_mesh(to_host_vector(model.positions()).data(), n, tri.data(),
+                static_cast<int>(mesh.triangles.size()), node_cell.data());
+  const std::string csv_tmp = out + "/series.csv.part";
+  std::ofstream csv(csv_tmp);
+  csv << "t_s,r_cc_m,contact_area_m2,area_m2,volume_m3,cg_iterations,dt_s,height_m,contact_load_N,"
+         "elastic_energy_J,dE_dt_W,contact_power_W,dissipation_W,energy_residual_W\n";
+  if (!options.quiet)
+    std::printf("dcm spread: scene '%s', %d nodes, dt = %.3g s, t_end = %.3g s (%lld steps); %s\n",
+                scene.name().c_str(), n, dt, t_end, steps, kokkos_description().c_str());
+
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  const std::vector<double> figure_times = {0.1, 0.35, 0.9};  // paper Figures 1 and 6
+  std::size_t next_figure = 0;
+  double next_frame = 0, next_sample = 0;
+  std::vector<double> ts, rs;
+  long long cg_total = 0, step = 0;
+  int cg_max = 0;
+  double worst_residual = 0, worst_residual_scale = 0;
+  auto last_progress = std::chrono::steady_clock::now();
+  bool interrupted = false;
+
+  auto write_frame = [&](double t) {
+    model.node_fields(fields);
+    const auto x = to_host_vector(model.positions());
+    const auto tension = to_host_vector(fields.tension), stretch = to_host_vector(fields.stretch);
+    const auto fn = to_host_vector(fields.normal_force), pn = to_host_vector(fields.normal_pressure);
+    h5.write_frame(t, x.data(),
+                   {{"cortex_tension_J_per_m2", 1, tension.data()},
+                    {"stretch", 1, stretch.data()},
+                    {"normal_force_N", 1, fn.data()},
+                    {"normal_pressure_Pa", 1, pn.data()}});
+  };
+
+  for (; step <= steps; ++step) {
+    const double t = step * dt;
+    CgResult r;
+    try {
+      model.compute_forces();
+      r = model.solve_velocity(cg, dt);
+    } catch (const NumericalError& e) {
+      h5.close();  // what was done stays readable
+      csv.close();
+      std::rename(csv_tmp.c_str(), (out + "/series.csv").c_str());
+      throw NumericalError("step " + std::to_string(step) + " (t = " + std::to_string(t) +
+                           " s): " + e.what() + " — try a smaller time.dt_s");
+    }
+    cg_total += r.iterations;
+    cg_max = std::max(cg_max, r.iterations);
+    const bool figure = next_figure < figure_times.size() && t + 0.5 * dt >= figure_times[next_figure];
+    if (t >= next_frame - 0.5 * dt || figure || step == steps) {
+      write_frame(t);
+      while (next_frame <= t + 0.5 * dt) next_frame += frame_every;
+      while (next_figure < figure_times.size() && figure_times[next_figure] <= t + 0.5 * dt) ++next_figure;
+    }
+    const bool sample = t >= next_sample || step == steps || step < 10;
+    double e0 = 0, pc = 0, dis = 0;
+    if (sample) {
+      e0 = model.energy();
+      pc = model.contact_power();
+      dis = model.dissipation();
+    }
+    model.advance(dt);
+    if (sample) {
+      // Energy balance of the step: (E(t+dt) − E(t))/dt against the contact power minus the dissipation.
+      const double de = (model.energy() - e0) / dt, residual = de - (pc - dis);
+      worst_residual = std::max(worst_residual, std::fabs(residual));
+      worst_residual_scale = std::max(worst_residual_scale, std::fabs(dis) + std::fabs(pc));
+      const double area_c = model.contact_area(), r_cc = std::sqrt(area_c / kPi);
+      const auto xh = to_host_vector(model.positions());
+      double ztop = -INFINITY;
+      for (int i = 0; i < n; ++i) ztop = std::max(ztop, xh[3 * i + 2]);
+      const double area = to_host_vector(model.geometry().cell_area)[0];
+      const double volume = to_host_vector(model.geometry().cell_volume)[0];
+      char line[512];
+      std::snprintf(line, sizeof line,
+                    "%.9g,%.9g,%.9g,%.9g,%.9g,%d,%.6g,%.9g,%.9g,%.12g,%.6g,%.6g,%.6g,%.6g\n", t, r_cc, area_c,
+                    area, volume, r.iterations, dt, ztop - plane_z, model.contact_load(), e0, de, pc, dis,
+                    residual);
+      csv << line;
+      h5.append_series(
+          {{"t_s", t}, {"r_cc_m", r_cc}, {"contact_area_m2", area_c}, {"height_m", ztop - plane_z}});
+      ts.push_back(t);
+      rs.push_back(r_cc);
+      next_sample = std::max(t * std::pow(10.0, 1.0 / per_decade), t + dt);
+      if (!options.quiet && seconds_since(last_progress) > 2.0) {
+        const double wall = seconds_since(wall0), rate = (step + 1) / wall;
+        std::printf("  t = %.4f s  r_cc = %.3f um  CG %d it  %.0f steps/s  ETA %.0f s\n", t, r_cc * 1e6,
+                    r.iterations, rate, (steps - step) / rate);
+        std::fflush(stdout);
+        last_progress = std::chrono::steady_clock::now();
+      }
+    }
+    if (g_stop) {
+      interrupted = true;
+      write_frame(t + dt);
+      ++step;
+      break;
+    }
+  }
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  csv.close();
+  std::rename(csv_tmp.c_str(), (out + "/series.csv").c_str());
+  h5.close();
+
+  const long long done = std::min(step, steps + 1);
+  const auto x = to_host_vector(model.positions());
+  double ztop = -INFINITY;
+  for (int i = 0; i < n; ++i) ztop = std::max(ztop, x[3 * i + 2]);
+  const CapFit cap = fit_cap(x, plane_z);
+  int used = 0;
+  const double alpha = fit_exponent(ts, rs, so.early_from_s, so.early_to_s, used);
+  const double wall = seconds_since(wall0);
+  JsonObject summary;
+  summary.add("scene", scene.name())
+      .add("nodes", n)
+      .add("interrupted", interrupted)
+      .add("t_end_s", done > 0 ? (done - 1) * dt : 0.0)
+      .add("r_cc_final_m", rs.empty() ? 0.0 : rs.back())
+      .add("contact_angle_deg", cap.angle_deg)
+      .add("cap_radius_m", cap.radius)
+      .add("early_exponent", alpha)
+      .add("early_window_s", std::vector<double>{so.early_from_s, so.early_to_s})
+      .add("early_window_rows", used)
+      .add("height_final_m", ztop - plane_z)
+      .add("steps", done)
+      .add("dt_s", dt)
+      .add("wall_s", wall)
+      .add("mean_cg_iterations", done > 0 ? static_cast<double>(cg_total) / done : 0.0)
+      .add("max_cg_iterations", cg_max)
+      .add("energy_residual_max_W", worst_residual)
+      .add("energy_residual_relative",
+           worst_residual_scale > 0 ? worst_residual / worst_residual_scale : 0.0);
+  summary.write(out + "/summary.json");
+  if (!options.quiet)
+    std::printf(
+        "  r_cc = %.3f um, contact angle %.1f deg, early exponent %.3f (t in [%g, %g] s), height %.3f um; "
+        "%lld steps in %.1f s, mean CG %.1f\n",
+        (rs.empty() ? 0.0 : rs.back()) * 1e6, cap.angle_deg, alpha, so.early_from_s, so.early_to_s,
+        (ztop - plane_z) * 1e6, done, wall, done > 0 ? static_cast<double>(cg_total) / done : 0.0);
+  if (so.plot && !interrupted) {
+    const std::string cmd =
+        std::string(DCM_PYTHON3) + " '" + DCM_SOURCE_DIR + "/scripts/plot_spread.py' '" + out + "'";
+    if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "spread: plotting failed (%s)\n", cmd.c_str());
+  }
+  if (interrupted)
+    throw AppInterrupted("interrupted at t = " + std::to_string((done - 1) * dt) + " s; " + out +
+                         "/spread.h5, series.csv and summary.json hold what was done");
+}
+
+}  // namespace
+}  // namespace dcm
+
+int main(int argc, char** argv) {
+  CLI::App app(
+      "Cell spreading on an adhesive plane (the paper's Figures 1, 4-6). Without a scene file it runs the\n"
+      "built-in defaults with a plane; the paper's cases are in scenes/ (hategan2004_sphered.toml, ...).",
+      "spread");
+  dcm::AppOptions options;
+  dcm::SpreadOptions so;
+  dcm::add_common_options(app, options);
+  app.add_flag(
+      "--no-plot", [&](std::int64_t) { so.plot = false; }, "Do not write the PNG plots");
+  std::vector<double> window;
+  app.add_option("--early-window-s", window,
+                 "Time window FROM,TO (s) of the early power-law fit (default 0.002,0.05)")
+      ->delimiter(',')
+      ->expected(2);
+  return dcm::run_app(app, argc, argv, [&] {
+    if (window.size() == 2) {
+      so.early_from_s = window[0];
+      so.early_to_s = window[1];
+    }
+    dcm::run(options, so);
+  });
+}

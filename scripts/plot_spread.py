@@ -1,0 +1,142 @@
+#!/usr/bin/env python3
+"""Plots of a spread run (apps/spread): r_cc.png, cells.png, side_views.png in the run's folder.
+
+    python3 scripts/plot_spread.py OUT_DIR
+
+r_cc.png    contact radius against time on log-log axes with a t^(1/2) guide and the fitted early slope
+            (paper Figure 4 style)
+cells.png   the cell at the frames nearest t = 0.1, 0.35, 0.9 s, coloured by the normal force per node
+            (top) and the cortex tension of eq. 1 (bottom) (paper Figure 6 style)
+side_views.png  side views (x-z) of the cell at the frames nearest t = 0, 0.1, 0.35, 0.9 s and the end
+            (paper Figure 1 style)
+"""
+import csv
+import json
+import os
+import sys
+
+os.environ.setdefault("HDF5_USE_FILE_LOCKING", "FALSE")
+import h5py  # noqa: E402
+import matplotlib  # noqa: E402
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def read_series(path):
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]}
+
+
+def frames(h5):
+    out = []
+    for name in sorted(h5["frames"].keys()):
+        g = h5["frames"][name]
+        out.append((float(g.attrs["time"]) if "time" in g.attrs else float(name), g))
+    return out
+
+
+def nearest(frame_list, t):
+    return min(frame_list, key=lambda f: abs(f[0] - t))
+
+
+def plot_rcc(out, s, summary):
+    t, r = s["t_s"], s["r_cc_m"]
+    keep = (t > 0) & (r > 0)
+    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    ax.loglog(t[keep], r[keep] * 1e6, "-", color="C0", label="dcm: r_cc(t)")
+    if keep.any():
+        t0, r0 = t[keep][len(t[keep]) // 4], r[keep][len(t[keep]) // 4] * 1e6
+        tt = np.array([t[keep][0], t[keep][-1]])
+        ax.loglog(tt, r0 * (tt / t0) ** 0.5, "k--", lw=0.8, label=r"$\propto t^{1/2}$")
+    alpha = summary.get("early_exponent")
+    w = summary.get("early_window_s", [])
+    if alpha is not None and np.isfinite(alpha) and len(w) == 2:
+        m = keep & (t >= w[0]) & (t <= w[1])
+        if m.sum() >= 2:
+            c = np.polyfit(np.log(t[m]), np.log(r[m] * 1e6), 1)
+            ax.loglog(t[m], np.exp(np.polyval(c, np.log(t[m]))), "C3-", lw=2.5, alpha=0.6,
+                      label=f"fit {w[0]:g}-{w[1]:g} s: slope {alpha:.2f}")
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel(r"$r_{cc}$ (µm)")
+    ax.set_title(f"{summary.get('scene', '')}: {summary.get('nodes', '')} nodes")
+    ax.legend(fontsize=8)
+    ax.grid(True, which="both", lw=0.3)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "r_cc.png"), dpi=130)
+    plt.close(fig)
+
+
+def plot_cells(out, h5, tri):
+    fl = frames(h5)
+    picks = [nearest(fl, t) for t in (0.1, 0.35, 0.9)]
+    fig = plt.figure(figsize=(12, 7.5))
+    for row, (field, label, cmap) in enumerate(
+            [("normal_force_N", "normal force (pN)", "coolwarm"),
+             ("cortex_tension_J_per_m2", "cortex tension (µN/m)", "viridis")]):
+        scale = 1e12 if field == "normal_force_N" else 1e6
+        vals = [np.asarray(g[field]) * scale for _, g in picks]
+        lim = max(np.percentile(np.abs(v), 98) for v in vals) or 1.0
+        vmin, vmax = (-lim, lim) if field == "normal_force_N" else (min(v.min() for v in vals), lim)
+        for col, ((t, g), v) in enumerate(zip(picks, vals)):
+            x = np.asarray(g["x"]) * 1e6
+            ax = fig.add_subplot(2, 3, 3 * row + col + 1, projection="3d")
+            face = v[tri].mean(axis=1)
+            surf = ax.plot_trisurf(x[:, 0], x[:, 1], x[:, 2], triangles=tri, cmap=cmap, linewidth=0,
+                                   antialiased=False)
+            surf.set_array(face)
+            surf.set_clim(vmin, vmax)
+            ax.view_init(elev=20, azim=-60)
+            ax.set_box_aspect((np.ptp(x[:, 0]), np.ptp(x[:, 1]), max(np.ptp(x[:, 2]), 1e-3)))
+            ax.set_title(f"t = {t:.3f} s", fontsize=9)
+            ax.set_axis_off()
+            if col == 2:
+                fig.colorbar(surf, ax=ax, shrink=0.6, label=label)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "cells.png"), dpi=110)
+    plt.close(fig)
+
+
+def plot_side_views(out, h5):
+    fl = frames(h5)
+    times = [0.0, 0.1, 0.35, 0.9, fl[-1][0]]
+    picks = []
+    for t in times:
+        f = nearest(fl, t)
+        if all(abs(f[0] - p[0]) > 1e-12 for p in picks):
+            picks.append(f)
+    fig, axes = plt.subplots(1, len(picks), figsize=(3.0 * len(picks), 3.0), sharey=True)
+    axes = np.atleast_1d(axes)
+    for ax, (t, g) in zip(axes, picks):
+        x = np.asarray(g["x"]) * 1e6
+        band = np.abs(x[:, 1]) < 0.25 * np.ptp(x[:, 1]) / 2 + 1e-9
+        ax.plot(x[band, 0], x[band, 2], ".", ms=2, color="C0")
+        ax.axhline(0, color="k", lw=1)
+        ax.set_aspect("equal")
+        ax.set_title(f"t = {t:.3f} s", fontsize=9)
+        ax.set_xlabel("x (µm)")
+    axes[0].set_ylabel("z (µm)")
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "side_views.png"), dpi=130)
+    plt.close(fig)
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit("usage: plot_spread.py OUT_DIR")
+    out = sys.argv[1]
+    s = read_series(os.path.join(out, "series.csv"))
+    with open(os.path.join(out, "summary.json")) as f:
+        summary = json.load(f)
+    plot_rcc(out, s, summary)
+    with h5py.File(os.path.join(out, "spread.h5"), "r") as h5:
+        tri = np.asarray(h5["mesh"]["triangles"])
+        plot_cells(out, h5, tri)
+        plot_side_views(out, h5)
+    print(f"wrote {out}/r_cc.png, {out}/cells.png, {out}/side_views.png")
+
+
+if __name__ == "__main__":
+    main()
