@@ -150,6 +150,9 @@ std::vector<ParamSpec> make_schema() {
       bool_key(
           "solver.implicit_bending", "true",
           "bending's Gauss–Newton stiffness in the velocity solve: stable at the paper's Δt on fine meshes"),
+      bool_key("solver.implicit_bonds", "true",
+               "the bonds' axial FENE+POW stiffness Δt k'(d) in the velocity solve: a bond near d_max cannot "
+               "overshoot it (the paper's forward Euler: false)"),
 
       string_key("output.dir", "", {}, "output directory (empty: out/<name>)"),
       bool_key("output.hdf5", "true", "write the HDF5 + XDMF output"),

@@ -43,6 +43,15 @@ KOKKOS_INLINE_FUNCTION double fene_pow_force_magnitude(double d, double d_rest, 
   return k_s * d / (1 - d * d / d_max2) - k_c / (d * d);
 }
 
+// dF/dd of one bond (N/m): its axial stiffness, positive for every 0 < d < d_max (the FENE part grows
+// without bound as d → d_max; the POW part adds 2 k_c / d³).
+KOKKOS_INLINE_FUNCTION double fene_pow_axial_stiffness(double d, double d_rest, double k_s, double x_max) {
+  const double d_max2 = x_max * x_max * d_rest * d_rest;
+  const double k_c = k_s * d_rest * d_rest * d_rest / (1 - 1 / (x_max * x_max));
+  const double q = 1 - d * d / d_max2;
+  return k_s * (1 + d * d / d_max2) / (q * q) + 2 * k_c / (d * d * d);
+}
+
 // U of one bond (J), eq. 21 + k_c / d; only for 0 < d < d_max.
 KOKKOS_INLINE_FUNCTION double fene_pow_bond_energy(double d, double d_rest, double k_s, double x_max) {
   const double d_max2 = x_max * x_max * d_rest * d_rest;

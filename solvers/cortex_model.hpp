@@ -47,6 +47,7 @@ struct MechanicsParams {
   double viscosity = 0.8e-3;      // η (Pa·s), Stokes drag 6πηr/N per node
   double h_min = 1e4;             // 1/m, triangle curvature clamp
   bool multigrid = false;         // V-cycle preconditioner (where the mesh has an icosphere hierarchy)
+  bool implicit_bonds = false;    // the bonds' axial stiffness Δt k'(d) in the solve (stiff FENE near d_max)
   bool implicit_bending =
       false;                  // bending's Gauss-Newton stiffness in the solve (solvers/bending_stiffness.hpp)
   double gravity = 0;         // m/s², along −z (paper eq. 32's F_gravity); 0: no gravity term
@@ -181,7 +182,28 @@ class CortexModel {
   // linearly implicit, (Γ + dt K) v = F (solvers/global_stiffness.hpp, bending_stiffness.hpp); dt = 0 solves
   // Γ v = F. Without dashpots and implicit terms Γ is
   // diagonal and the solve is one multiplication per node.
+  // With params().implicit_bonds, the bonds' axial stiffness too (Δt k'(d_b) n̂n̂ᵀ per bond, added to the
+  // dashpot coefficient in the friction operator): a FENE bond close to d_max cannot overshoot it.
   CgResult solve_velocity(const CgSettings& settings, double dt = 0) {
+    const bool implicit_bonds = dt > 0 && params_.implicit_bonds && bonds_.has_value();
+    if (implicit_bonds) {
+      if (friction_.bond_stiffness_dt.extent(0) == 0)
+        friction_.bond_stiffness_dt =
+            Kokkos::View<double*, Kokkos::LayoutRight, Mem>("dcm::model::bond_k_dt", mesh_.n_bonds);
+      const auto x = mesh_.x;
+      const auto bond = mesh_.bond;
+      const auto rest = bonds_->rest_length;
+      const auto k_dt = friction_.bond_stiffness_dt;
+      const double k_s = params_.bonds.k_s, x_max = params_.bonds.x_max;
+      Kokkos::parallel_for(
+          "dcm::model::implicit_bonds", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_bonds),
+          KOKKOS_LAMBDA(const int b) {
+            const double d = norm(load3(x, bond(b, 1)) - load3(x, bond(b, 0)));
+            k_dt(b) = dt * fene_pow_axial_stiffness(d, rest(b), k_s, x_max);
+          });
+    } else {
+      friction_.bond_stiffness_dt = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
+    }
     update_friction(space_, mesh_, friction_);
     if (multigrid_) update_multigrid(space_, mesh_, friction_, *multigrid_);
     const bool implicit = dt > 0 && global_.has_value();
@@ -193,7 +215,7 @@ class CortexModel {
                               volume_ ? volume_->cell_volume : area_->cell_area, params_.k_area_global,
                               params_.k_volume, dt, *global_);
     if (params_.dashpot == 0 && params_.dashpot_transverse == 0 && !friction_.substrate && !implicit &&
-        !implicit_bending) {
+        !implicit_bending && !implicit_bonds) {
       apply_block_jacobi(space_, friction_, force_, velocity_);
       CgResult r;
       r.converged = true;
@@ -250,7 +272,9 @@ class CortexModel {
 
   // vᵀ Γ v: the power dissipated by the friction (W), for the energy balance.
   double dissipation() {
-    apply_friction(space_, mesh_, friction_, velocity_, cg_.q);
+    FrictionOperator<Mem> gamma = friction_;  // Γ alone, without the implicit bond stiffness
+    gamma.bond_stiffness_dt = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
+    apply_friction(space_, mesh_, gamma, velocity_, cg_.q);
     return cg_detail::dot(space_, velocity_, cg_.q);
   }
 

@@ -35,6 +35,9 @@ struct FrictionOperator {
   double dashpot_transverse = 0;    // c_t (N·s/m), across the bond; c = c_t = 0: Γ is diagonal
   View<double* [3]> bond_dir;       // n̂_b, cached per step
   View<double* [6]> block_inverse;  // inverse of each node's 3×3 diagonal block: xx, yy, zz, xy, xz, yz
+  // Linearly implicit bonds (solvers/cortex_model.hpp): Δt·k'(d_b) per bond, added to the axial dashpot
+  // coefficient, so the operator is Γ + Δt K_bonds (same structure, SPD: k' > 0). Empty: none.
+  View<double*> bond_stiffness_dt;
 
   // Substrate friction; off (no kernels) unless enable_substrate_friction() was called.
   bool substrate = false;
@@ -144,12 +147,14 @@ void update_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>
   const Real3 sn = op.substrate_normal;
   const double pin = op.pin_friction;
   const auto regime = op.tri_regime;
+  const auto bond_k = op.bond_stiffness_dt;
+  const bool stiff = bond_k.extent(0) > 0;
   Kokkos::parallel_for(
       "dcm::friction::block_jacobi", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
         double a[6] = {drag(i), drag(i), drag(i), 0, 0, 0};
         for (int s = offsets(i); s < offsets(i + 1); ++s)
-          add_dashpot_block(load3(dir, bonds(s)), c, c_t, 1.0, a);
+          add_dashpot_block(load3(dir, bonds(s)), c + (stiff ? bond_k(bonds(s)) : 0.0), c_t, 1.0, a);
         if (substrate)
           for (int k = tri_offsets(i); k < tri_offsets(i + 1); ++k) {
             const int t = corners(k) / 3;
@@ -186,6 +191,8 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
   const auto scratch = op.tri_scratch;
   const double pin = op.pin_friction;
   const auto regime = op.tri_regime;
+  const auto bond_k = op.bond_stiffness_dt;
+  const bool stiff = bond_k.extent(0) > 0;
   if (substrate) {  // u_t = Γ_t Σ_j β_tj v_j for the triangles in contact
     const auto tri = mesh.tri;
     const auto contact_area = op.tri_contact_area;
@@ -213,7 +220,7 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
           const int j = bond(b, 0) == i ? bond(b, 1) : bond(b, 0);
           const Real3 n = load3(dir, b), dv = vi - load3(v, j);
           const double along = dot(n, dv);
-          acc += (c * along) * n;                       // eq. 25: dashpot along the bond
+          acc += ((c + (stiff ? bond_k(b) : 0.0)) * along) * n;  // eq. 25: dashpot along the bond
           if (c_t != 0) acc += c_t * (dv - along * n);  // optional transverse part (eq. 32's c (v_i − v_j))
         }
         if (substrate)

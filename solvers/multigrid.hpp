@@ -208,6 +208,8 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
     const Real3 sn = op.substrate_normal;
     const double pin = op.pin_friction;
     const auto regime = op.tri_regime;
+    const auto bond_k = op.bond_stiffness_dt;
+    const bool stiff = bond_k.extent(0) > 0;
     Kokkos::parallel_for(
         "dcm::mg::assemble_fine", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows),
         KOKKOS_LAMBDA(const int i) {
@@ -223,7 +225,8 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
               blk[2] += pin;
             }
             for (int t = first; t < last; ++t) {
-              add_dashpot_block(load3(dir, b >= 0 ? b : node_bonds(t)), c, c_t, sign, blk);
+              const int bb = b >= 0 ? b : node_bonds(t);
+              add_dashpot_block(load3(dir, bb), c + (stiff ? bond_k(bb) : 0.0), c_t, sign, blk);
             }
             if (substrate) {
               const int j = cols(s);

@@ -370,3 +370,27 @@ TEST(BondsBendingBackends, SerialAndOpenMPAgree) {
 
 }  // namespace
 }  // namespace dcm
+
+namespace dcm {
+namespace {
+// The axial stiffness used by the linearly implicit bonds is dF/dd of the FENE+POW force (central
+// differences, relative 1e-7), positive everywhere, and grows without bound towards d_max.
+TEST(FenePow, AxialStiffnessIsTheDerivativeOfTheForce) {
+  const double k_s = 3.2e-6, x_max = 2.05, d0 = 0.5e-6;
+  double previous = 0;
+  for (double s : {0.5, 0.8, 1.0, 1.3, 1.7, 2.0, 2.04, 2.049}) {
+    const double d = s * d0, h = 1e-6 * d * (x_max - s);
+    const double fd =
+        (fene_pow_force_magnitude(d + h, d0, k_s, x_max) - fene_pow_force_magnitude(d - h, d0, k_s, x_max)) /
+        (2 * h);
+    const double k = fene_pow_axial_stiffness(d, d0, k_s, x_max);
+    EXPECT_NEAR(k, fd, 1e-6 * k) << "stretch " << s;
+    EXPECT_GT(k, 0.0);
+    if (s > 1.0) {
+      EXPECT_GT(k, previous) << "stiffer towards d_max";
+    }
+    previous = k;
+  }
+}
+}  // namespace
+}  // namespace dcm
