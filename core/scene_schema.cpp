@@ -129,6 +129,10 @@ std::vector<ParamSpec> make_schema() {
       real_key("contact.gamma_n_N_s_per_m3", "8e9", 0, 1e15, kIncl, "N·s/m³", "normal substrate friction"),
       real_key("contact.gamma_t_N_s_per_m3", "6e9", 0, 1e15, kIncl, "N·s/m³",
                "tangential substrate friction"),
+      string_key(
+          "contact.friction_zone", "adhesive", {"adhesive", "contact"},
+          "where the substrate friction acts on a triangle: adhesive = within r < max(a, c), the contact "
+          "and adhesive zone (dcm); contact = within the contact radius a only (the paper's A^C)"),
       real_key(
           "contact.pin_friction_N_s_per_m", "0", 0, 1, kIncl, "N·s/m",
           "extra friction on nodes whose triangles all lie fully in the contact (the paper's pinning; 0: "

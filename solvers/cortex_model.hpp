@@ -131,6 +131,24 @@ class CortexModel {
     if (!bonds_) throw std::logic_error("node_fields() needs the FENE+POW bond term");
     compute_node_fields(space_, mesh_, geo_, *bonds_, params_.bonds, force_, out);
   }
+  // Largest d / d_max over the bonds at the current positions (0 without bonds).
+  double max_bond_extension() const {
+    if (!bonds_) return 0.0;
+    const auto x = mesh_.x;
+    const auto bond = mesh_.bond;
+    const auto rest = bonds_->rest_length;
+    const double x_max = params_.bonds.x_max;
+    double m = 0;
+    Kokkos::parallel_reduce(
+        "dcm::model::max_bond_extension", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_bonds),
+        KOKKOS_LAMBDA(const int b, double& a) {
+          const double e = norm(load3(x, bond(b, 1)) - load3(x, bond(b, 0))) / (x_max * rest(b));
+          if (!(e <= a)) a = e;  // NaN propagates as "not below"
+        },
+        Kokkos::Max<double>(m));
+    return m;
+  }
+
   // Power of the contact forces at the current velocity (W); 0 without a plane.
   double contact_power() const {
     return contact_ ? dcm::contact_power(space_, mesh_, params_.plane, *contact_, velocity_) : 0.0;

@@ -1,0 +1,63 @@
+#!/usr/bin/env python3
+"""Checks a spread run's output: check_spread.py OUT_DIR [--interrupted]
+
+series.csv has the required columns and finite rows, r_cc grows, summary.json has the required keys, the
+energy balance residual is small against the powers, the HDF5 file opens and holds frames with the node
+fields. With --interrupted: the summary says so and the files are still valid."""
+import csv
+import json
+import math
+import os
+import sys
+
+os.environ.setdefault("HDF5_USE_FILE_LOCKING", "FALSE")
+import h5py  # noqa: E402
+
+REQUIRED = ["t_s", "r_cc_m", "contact_area_m2", "area_m2", "volume_m3", "cg_iterations", "dt_s"]
+KEYS = ["r_cc_final_m", "contact_angle_deg", "early_exponent", "height_final_m", "steps", "wall_s",
+        "mean_cg_iterations"]
+FIELDS = ["cortex_tension_J_per_m2", "stretch", "normal_force_N", "normal_pressure_Pa"]
+
+
+def fail(msg):
+    print("check_spread: " + msg)
+    sys.exit(1)
+
+
+def main():
+    out = sys.argv[1]
+    interrupted = "--interrupted" in sys.argv
+    with open(os.path.join(out, "series.csv")) as f:
+        reader = csv.DictReader(f)
+        for c in REQUIRED:
+            if c not in reader.fieldnames:
+                fail(f"series.csv has no column {c}")
+        rows = list(reader)
+    if len(rows) < 5:
+        fail(f"series.csv has {len(rows)} rows")
+    for r in rows:
+        for k, v in r.items():
+            if not math.isfinite(float(v)):
+                fail(f"non-finite {k} = {v} at t = {r['t_s']}")
+    if not float(rows[-1]["r_cc_m"]) > float(rows[1]["r_cc_m"]):
+        fail("r_cc did not grow")
+    s = json.load(open(os.path.join(out, "summary.json")))
+    for k in KEYS:
+        if k not in s:
+            fail(f"summary.json has no key {k}")
+    if s.get("interrupted") != interrupted:
+        fail(f"summary.json interrupted = {s.get('interrupted')}, expected {interrupted}")
+    if not interrupted and not s["energy_residual_relative"] < 0.05:
+        fail(f"energy residual {s['energy_residual_relative']} of the powers")
+    with h5py.File(os.path.join(out, "spread.h5"), "r") as h5:
+        frames = list(h5["frames"].keys())
+        if not frames:
+            fail("no frames in spread.h5")
+        for name in FIELDS:
+            if name not in h5["frames"][frames[-1]]:
+                fail(f"frame {frames[-1]} has no field {name}")
+    print(f"check_spread: {out}: {len(rows)} rows, {len(frames)} frames, r_cc {float(rows[-1]['r_cc_m']):.3g} m")
+
+
+if __name__ == "__main__":
+    main()
