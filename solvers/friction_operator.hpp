@@ -119,6 +119,60 @@ KOKKOS_INLINE_FUNCTION void add_dashpot_block(Real3 n, double c, double c_t, dou
   blk[5] += a * n.y * n.z;
 }
 
+// The substrate friction and pin coefficients of a FrictionOperator, captured by value into kernels:
+// add_block(i, j, blk) adds the (i, j) block of Σ_t β_ti β_tj Γ_t (+ the pin on the diagonal of a node fully
+// in contact), j a node of one of i's triangles or i itself. Used by block-Jacobi and the multigrid's level
+// 0.
+template <class MemorySpace>
+struct SubstrateBlocks {
+  template <class T>
+  using View = Kokkos::View<T, Kokkos::LayoutRight, MemorySpace>;
+  bool on = false;
+  double gamma_n = 0, gamma_t = 0, pin = 0;
+  Real3 normal{0, 0, 1};
+  View<int* [3]> tri;
+  View<int*> tri_offsets, corners, regime;
+  View<double* [3]> beta;
+  View<double*> area;
+
+  KOKKOS_INLINE_FUNCTION void add_block(int i, int j, double blk[6]) const {
+    if (!on) return;
+    for (int q = tri_offsets(i); q < tri_offsets(i + 1); ++q) {
+      const int t = corners(q) / 3;
+      const double a = area(t);
+      if (!(a > 0)) continue;
+      for (int k = 0; k < 3; ++k)
+        if (tri(t, k) == j) {
+          const double w = beta(t, corners(q) % 3) * beta(t, k) * a;
+          add_dashpot_block(normal, w * gamma_n, w * gamma_t, 1.0, blk);  // β_ti β_tj Γ_t
+        }
+    }
+    if (i == j && pin > 0 && node_fully_in_contact(i, tri_offsets, corners, regime)) {
+      blk[0] += pin;
+      blk[1] += pin;
+      blk[2] += pin;
+    }
+  }
+};
+
+template <class MemorySpace>
+SubstrateBlocks<MemorySpace> substrate_blocks(const MeshBuffers<MemorySpace>& mesh,
+                                              const FrictionOperator<MemorySpace>& op) {
+  SubstrateBlocks<MemorySpace> s;
+  s.on = op.substrate;
+  s.gamma_n = op.gamma_n;
+  s.gamma_t = op.gamma_t;
+  s.pin = op.pin_friction;
+  s.normal = op.substrate_normal;
+  s.tri = mesh.tri;
+  s.tri_offsets = mesh.node_tri_offsets;
+  s.corners = mesh.node_tri_corners;
+  s.regime = op.tri_regime;
+  s.beta = op.tri_beta;
+  s.area = op.tri_contact_area;
+  return s;
+}
+
 // Caches n̂_b and the inverted diagonal blocks ζ_i I + Σ_b c n̂_b n̂_bᵀ for the current positions.
 template <class ExecutionSpace, class MemorySpace>
 void update_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
@@ -138,15 +192,7 @@ void update_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>
   const auto drag = op.node_drag;
   const auto inverse = op.block_inverse;
   const double c = op.dashpot, c_t = op.dashpot_transverse;
-  const bool substrate = op.substrate;
-  const auto tri_offsets = mesh.node_tri_offsets;
-  const auto corners = mesh.node_tri_corners;
-  const auto beta = op.tri_beta;
-  const auto contact_area = op.tri_contact_area;
-  const double gamma_n = op.gamma_n, gamma_t = op.gamma_t;
-  const Real3 sn = op.substrate_normal;
-  const double pin = op.pin_friction;
-  const auto regime = op.tri_regime;
+  const auto substrate = substrate_blocks(mesh, op);
   const auto bond_k = op.bond_stiffness_dt;
   const bool stiff = bond_k.extent(0) > 0;
   Kokkos::parallel_for(
@@ -155,17 +201,7 @@ void update_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>
         double a[6] = {drag(i), drag(i), drag(i), 0, 0, 0};
         for (int s = offsets(i); s < offsets(i + 1); ++s)
           add_dashpot_block(load3(dir, bonds(s)), c + (stiff ? bond_k(bonds(s)) : 0.0), c_t, 1.0, a);
-        if (substrate)
-          for (int k = tri_offsets(i); k < tri_offsets(i + 1); ++k) {
-            const int t = corners(k) / 3;
-            const double b = beta(t, corners(k) % 3), w = b * b * contact_area(t);
-            if (w > 0) add_dashpot_block(sn, w * gamma_n, w * gamma_t, 1.0, a);  // β² Γ_t
-          }
-        if (pin > 0 && node_fully_in_contact(i, tri_offsets, corners, regime)) {
-          a[0] += pin;
-          a[1] += pin;
-          a[2] += pin;
-        }
+        substrate.add_block(i, i, a);  // β² Γ_t and the pin
         double inv[6];
         invert_sym3(a, inv);
         for (int k = 0; k < 6; ++k) inverse(i, k) = inv[k];

@@ -197,17 +197,8 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
     const double c = op.dashpot, c_t = op.dashpot_transverse;
     // Substrate friction blocks β_ti β_tj Γ_t (solvers/friction_operator.hpp) lie on the same pattern: the
     // corners of a triangle are bond neighbours.
-    const bool substrate = op.substrate;
     const auto cols = a.cols;
-    const auto tri = mesh.tri;
-    const auto tri_off = mesh.node_tri_offsets;
-    const auto corners = mesh.node_tri_corners;
-    const auto beta = op.tri_beta;
-    const auto contact_area = op.tri_contact_area;
-    const double gamma_n = op.gamma_n, gamma_t = op.gamma_t;
-    const Real3 sn = op.substrate_normal;
-    const double pin = op.pin_friction;
-    const auto regime = op.tri_regime;
+    const auto substrate = substrate_blocks(mesh, op);
     const auto bond_k = op.bond_stiffness_dt;
     const bool stiff = bond_k.extent(0) > 0;
     Kokkos::parallel_for(
@@ -219,28 +210,11 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
             const int first = b >= 0 ? 0 : node_off(i), last = b >= 0 ? 1 : node_off(i + 1);
             const double sign = b >= 0 ? -1.0 : 1.0;
             if (b < 0) blk[0] = blk[1] = blk[2] = drag(i);
-            if (b < 0 && pin > 0 && node_fully_in_contact(i, tri_off, corners, regime)) {
-              blk[0] += pin;
-              blk[1] += pin;
-              blk[2] += pin;
-            }
             for (int t = first; t < last; ++t) {
               const int bb = b >= 0 ? b : node_bonds(t);
               add_dashpot_block(load3(dir, bb), c + (stiff ? bond_k(bb) : 0.0), c_t, sign, blk);
             }
-            if (substrate) {
-              const int j = cols(s);
-              for (int q = tri_off(i); q < tri_off(i + 1); ++q) {
-                const int t = corners(q) / 3;
-                const double area = contact_area(t);
-                if (!(area > 0)) continue;
-                for (int k = 0; k < 3; ++k)
-                  if (tri(t, k) == j) {
-                    const double w = beta(t, corners(q) % 3) * beta(t, k) * area;
-                    add_dashpot_block(sn, w * gamma_n, w * gamma_t, 1.0, blk);
-                  }
-              }
-            }
+            substrate.add_block(i, cols(s), blk);
             for (int k = 0; k < 6; ++k) val(s, k) = blk[k];
           }
         });
