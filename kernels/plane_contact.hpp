@@ -235,26 +235,27 @@ void add_plane_contact_forces(const ExecutionSpace& space, const MeshBuffers<Mem
       });
 }
 
+namespace detail {
+template <class ExecutionSpace, class View>
+double sum_of(const ExecutionSpace& space, const char* label, const View& v) {
+  double sum = 0;
+  Kokkos::parallel_reduce(
+      label, Kokkos::RangePolicy<ExecutionSpace>(space, 0, v.extent(0)),
+      KOKKOS_LAMBDA(const int t, double& s) { s += v(t); }, sum);
+  return sum;
+}
+}  // namespace detail
+
 // Σ_t A^C_t per cell is what r_cc = sqrt(A^C / π) needs; here the whole mesh (one cell).
 template <class ExecutionSpace, class MemorySpace>
 double total_contact_area(const ExecutionSpace& space, const ContactBuffers<MemorySpace>& contact) {
-  const auto a = contact.tri_contact_area;
-  double sum = 0;
-  Kokkos::parallel_reduce(
-      "dcm::contact::area", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.extent(0)),
-      KOKKOS_LAMBDA(const int t, double& s) { s += a(t); }, sum);
-  return sum;
+  return detail::sum_of(space, "dcm::contact::area", contact.tri_contact_area);
 }
 
 // Σ_t F_t · n (N).
 template <class ExecutionSpace, class MemorySpace>
 double total_contact_load(const ExecutionSpace& space, const ContactBuffers<MemorySpace>& contact) {
-  const auto f = contact.tri_load;
-  double sum = 0;
-  Kokkos::parallel_reduce(
-      "dcm::contact::load", Kokkos::RangePolicy<ExecutionSpace>(space, 0, f.extent(0)),
-      KOKKOS_LAMBDA(const int t, double& s) { s += f(t); }, sum);
-  return sum;
+  return detail::sum_of(space, "dcm::contact::load", contact.tri_load);
 }
 
 }  // namespace dcm
