@@ -59,6 +59,7 @@ struct MechanicsParams {
   PlaneContactParams contact;
   double gamma_n = 0, gamma_t = 0;
   double pin_friction = 0;  // N·s/m on nodes fully in contact (the paper's pinning); 0: off
+  bool lumped_friction = true;  // substrate friction w_i Γ_t per node (false: β_i β_j Γ_t), friction_operator.hpp
 };
 
 // Index of the first node with a non-finite component, or -1.
@@ -106,7 +107,8 @@ class CortexModel {
     if (p.has_plane) {
       contact_ = ContactBuffers<Mem>(mesh_.n_tris);
       if (p.gamma_n > 0 || p.gamma_t > 0 || p.pin_friction > 0)
-        enable_substrate_friction(friction_, *contact_, p.gamma_n, p.gamma_t, p.plane.normal, p.pin_friction);
+        enable_substrate_friction(friction_, *contact_, p.gamma_n, p.gamma_t, p.plane.normal, p.pin_friction,
+                                  p.lumped_friction);
     }
     if (p.multigrid && (p.dashpot > 0 || p.dashpot_transverse > 0)) {
       multigrid_ = make_multigrid(cells, mesh_);

@@ -12,7 +12,10 @@
 //
 // Substrate friction (MODEL.md section 5): Γ_t = A^C_t [γ_n n̂n̂ᵀ + γ_t (I − n̂n̂ᵀ)] acts on the velocity of
 // the triangle's contact point Σ_j β_tj v_j, spread back with the same weights β (those of the contact force,
-// kernels/plane_contact.hpp): the blocks β_ti β_tj Γ_t are symmetric positive semi-definite.
+// kernels/plane_contact.hpp): the blocks β_ti β_tj Γ_t are symmetric positive semi-definite ("consistent").
+// The "lumped" alternative (row-sum lumping, as for a lumped mass matrix) puts w_ti Γ_t on each corner's own
+// velocity, w_ti = max(β_ti, 0) / Σ_k max(β_tk, 0): the same force on a rigidly moving triangle, but every
+// node in contact is damped, not only the contact point; diagonal blocks only (docs/model/spread.md).
 //
 // Coefficients (n̂_b and each node's 3×3 diagonal block, inverted for the block-Jacobi preconditioner)
 // are cached once per step by update(); apply() is a gather over each node's bonds (no atomics).
@@ -43,6 +46,7 @@ struct FrictionOperator {
   bool substrate = false;
   double gamma_n = 0, gamma_t = 0;  // N·s/m³
   Real3 substrate_normal{0, 0, 1};
+  bool substrate_lumped = false;   // w_ti Γ_t on each node instead of β_ti β_tj Γ_t (see above)
   View<double* [3]> tri_beta;      // β per triangle corner (shared with the contact buffers)
   View<double*> tri_contact_area;  // the area each triangle's friction acts on (m²)
   View<double* [3]> tri_scratch;   // Γ_t Σ_j β_tj v_j per triangle
@@ -66,8 +70,9 @@ template <class MemorySpace>
 void enable_substrate_friction(FrictionOperator<MemorySpace>& op,
                                Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace> beta,
                                Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> area, double gamma_n,
-                               double gamma_t, Real3 normal) {
+                               double gamma_t, Real3 normal, bool lumped = false) {
   op.substrate = true;
+  op.substrate_lumped = lumped;
   op.gamma_n = gamma_n;
   op.gamma_t = gamma_t;
   op.substrate_normal = (1.0 / norm(normal)) * normal;
@@ -81,8 +86,9 @@ void enable_substrate_friction(FrictionOperator<MemorySpace>& op,
 // triangles all lie fully in the contact (their regime, refreshed by the contact kernel each step).
 template <class MemorySpace>
 void enable_substrate_friction(FrictionOperator<MemorySpace>& op, const ContactBuffers<MemorySpace>& contact,
-                               double gamma_n, double gamma_t, Real3 normal, double pin_friction = 0) {
-  enable_substrate_friction(op, contact.tri_beta, contact.tri_friction_area, gamma_n, gamma_t, normal);
+                               double gamma_n, double gamma_t, Real3 normal, double pin_friction = 0,
+                               bool lumped = false) {
+  enable_substrate_friction(op, contact.tri_beta, contact.tri_friction_area, gamma_n, gamma_t, normal, lumped);
   op.pin_friction = pin_friction;
   op.tri_regime = contact.tri_regime;
 }
@@ -92,6 +98,15 @@ KOKKOS_INLINE_FUNCTION Real3 substrate_block_times(Real3 n, double area, double 
                                                    Real3 u) {
   const double un = dot(n, u);
   return area * (gamma_t * u + ((gamma_n - gamma_t) * un) * n);
+}
+
+// The lumped weight of corner k of triangle t: max(β_tk, 0) / Σ_m max(β_tm, 0) (0 if all are ≤ 0).
+template <class BetaView>
+KOKKOS_INLINE_FUNCTION double lumped_weight(const BetaView& beta, int t, int k) {
+  const double b0 = beta(t, 0) > 0 ? beta(t, 0) : 0.0, b1 = beta(t, 1) > 0 ? beta(t, 1) : 0.0,
+               b2 = beta(t, 2) > 0 ? beta(t, 2) : 0.0, sum = b0 + b1 + b2;
+  const double bk = k == 0 ? b0 : (k == 1 ? b1 : b2);
+  return sum > 0 ? bk / sum : 0.0;
 }
 
 // Inverse of the symmetric 3×3 matrix (a00, a11, a22, a01, a02, a12), same packing.
@@ -127,7 +142,7 @@ template <class MemorySpace>
 struct SubstrateBlocks {
   template <class T>
   using View = Kokkos::View<T, Kokkos::LayoutRight, MemorySpace>;
-  bool on = false;
+  bool on = false, lumped = false;
   double gamma_n = 0, gamma_t = 0, pin = 0;
   Real3 normal{0, 0, 1};
   View<int* [3]> tri;
@@ -141,6 +156,13 @@ struct SubstrateBlocks {
       const int t = corners(q) / 3;
       const double a = area(t);
       if (!(a > 0)) continue;
+      if (lumped) {
+        if (i == j) {
+          const double w = lumped_weight(beta, t, corners(q) % 3) * a;
+          add_dashpot_block(normal, w * gamma_n, w * gamma_t, 1.0, blk);  // w_ti Γ_t
+        }
+        continue;
+      }
       for (int k = 0; k < 3; ++k)
         if (tri(t, k) == j) {
           const double w = beta(t, corners(q) % 3) * beta(t, k) * a;
@@ -160,6 +182,7 @@ SubstrateBlocks<MemorySpace> substrate_blocks(const MeshBuffers<MemorySpace>& me
                                               const FrictionOperator<MemorySpace>& op) {
   SubstrateBlocks<MemorySpace> s;
   s.on = op.substrate;
+  s.lumped = op.substrate_lumped;
   s.gamma_n = op.gamma_n;
   s.gamma_t = op.gamma_t;
   s.pin = op.pin_friction;
@@ -220,7 +243,7 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
   const auto dir = op.bond_dir;
   const auto drag = op.node_drag;
   const double c = op.dashpot, c_t = op.dashpot_transverse;
-  const bool substrate = op.substrate;
+  const bool substrate = op.substrate, lumped = op.substrate_lumped;
   const auto tri_offsets = mesh.node_tri_offsets;
   const auto corners = mesh.node_tri_corners;
   const auto beta = op.tri_beta;
@@ -229,11 +252,11 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
   const auto regime = op.tri_regime;
   const auto bond_k = op.bond_stiffness_dt;
   const bool stiff = bond_k.extent(0) > 0;
-  if (substrate) {  // u_t = Γ_t Σ_j β_tj v_j for the triangles in contact
+  const auto contact_area = op.tri_contact_area;
+  const double gamma_n = op.gamma_n, gamma_t = op.gamma_t;
+  const Real3 sn = op.substrate_normal;
+  if (substrate && !lumped) {  // u_t = Γ_t Σ_j β_tj v_j for the triangles in contact
     const auto tri = mesh.tri;
-    const auto contact_area = op.tri_contact_area;
-    const double gamma_n = op.gamma_n, gamma_t = op.gamma_t;
-    const Real3 sn = op.substrate_normal;
     Kokkos::parallel_for(
         "dcm::friction::substrate_triangles", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_tris),
         KOKKOS_LAMBDA(const int t) {
@@ -259,11 +282,19 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
           acc += ((c + (stiff ? bond_k(b) : 0.0)) * along) * n;  // eq. 25: dashpot along the bond
           if (c_t != 0) acc += c_t * (dv - along * n);  // optional transverse part (eq. 32's c (v_i − v_j))
         }
-        if (substrate)
+        if (substrate && lumped) {
+          for (int k = tri_offsets(i); k < tri_offsets(i + 1); ++k) {
+            const int t = corners(k) / 3;
+            const double area = contact_area(t);
+            if (area > 0)
+              acc += substrate_block_times(sn, lumped_weight(beta, t, corners(k) % 3) * area, gamma_n, gamma_t, vi);
+          }
+        } else if (substrate) {
           for (int k = tri_offsets(i); k < tri_offsets(i + 1); ++k) {
             const int t = corners(k) / 3;
             acc += beta(t, corners(k) % 3) * load3(scratch, t);
           }
+        }
         if (pin > 0 && node_fully_in_contact(i, tri_offsets, corners, regime)) acc += pin * vi;
         store3(out, i, acc);
       });

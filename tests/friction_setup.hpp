@@ -1,4 +1,5 @@
 #pragma once
+#include <algorithm>
 // Test fixture shared by tests/test_solver.cpp and tests/test_multigrid.cpp: the friction operator Γ with
 // the paper's parameters on perturbed icospheres, random vectors, and Γ assembled on the host with Eigen.
 #include <Eigen/Dense>
@@ -65,7 +66,7 @@ struct FrictionSetup {
   }
   // Substrate friction on random β (Σ = 1) and contact areas (a third of the triangles), γ_n = 8e9,
   // γ_t = 6e9 N·s/m³, a tilted plane normal; then update_friction().
-  void enable_random_substrate(unsigned seed) {
+  void enable_random_substrate(unsigned seed, bool lumped = false) {
     const int n_tris = mesh.n_tris;
     Kokkos::View<double* [3], Kokkos::LayoutRight, Mem> beta("beta", n_tris);
     Kokkos::View<double*, Kokkos::LayoutRight, Mem> area("area", n_tris);
@@ -74,7 +75,8 @@ struct FrictionSetup {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(0, 1);
     for (int t = 0; t < n_tris; ++t) {
-      const double b0 = u(rng), b1 = u(rng), b2 = u(rng), sum = b0 + b1 + b2;
+      // One corner in five gets a negative β (a centre of pressure outside the triangle).
+      const double b0 = u(rng) - (t % 5 == 0 ? 0.9 : 0.0), b1 = u(rng), b2 = u(rng) + 0.5, sum = b0 + b1 + b2;
       bh(t, 0) = b0 / sum;
       bh(t, 1) = b1 / sum;
       bh(t, 2) = b2 / sum;
@@ -82,7 +84,7 @@ struct FrictionSetup {
     }
     Kokkos::deep_copy(beta, bh);
     Kokkos::deep_copy(area, ah);
-    enable_substrate_friction(op, beta, area, 8e9, 6e9, Real3{0.2, -0.1, 1.0});
+    enable_substrate_friction(op, beta, area, 8e9, 6e9, Real3{0.2, -0.1, 1.0}, lumped);
     update_friction(Exec(), mesh, op);
   }
   // Γ assembled on the host from its definition (independent of the kernels): drag on the diagonal,
@@ -111,11 +113,17 @@ struct FrictionSetup {
       const Eigen::Vector3d sn(op.substrate_normal.x, op.substrate_normal.y, op.substrate_normal.z);
       const Eigen::Matrix3d g =
           op.gamma_n * sn * sn.transpose() + op.gamma_t * (Eigen::Matrix3d::Identity() - sn * sn.transpose());
-      for (std::size_t t = 0; t < area.size(); ++t)
+      for (std::size_t t = 0; t < area.size(); ++t) {
+        double positive[3], sum = 0;
+        for (int i = 0; i < 3; ++i) sum += positive[i] = std::max(beta[3 * t + i], 0.0);
         for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j)
-            a.block<3, 3>(3 * tri[3 * t + i], 3 * tri[3 * t + j]) +=
-                beta[3 * t + i] * beta[3 * t + j] * area[t] * g;
+          if (op.substrate_lumped)  // w_i Γ_t, w_i = max(β_i, 0) / Σ max(β, 0)
+            a.block<3, 3>(3 * tri[3 * t + i], 3 * tri[3 * t + i]) += positive[i] / sum * area[t] * g;
+          else
+            for (int j = 0; j < 3; ++j)
+              a.block<3, 3>(3 * tri[3 * t + i], 3 * tri[3 * t + j]) +=
+                  beta[3 * t + i] * beta[3 * t + j] * area[t] * g;
+      }
     }
     return a;
   }

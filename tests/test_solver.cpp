@@ -108,6 +108,38 @@ TEST(FrictionOperator, SubstrateBlocksMatchAssemblyAndKeepGammaSymmetricPositive
   EXPECT_LT((Eigen::Map<const Eigen::VectorXd>(xh.data(), xh.size()) - ref).norm(), 1e-8 * ref.norm());
 }
 
+// Lumped substrate friction (contact.friction_weights = lumped): w_ti Γ_t on each node's own velocity. It
+// matches its assembly, is diagonal in the nodes (block-Jacobi is exact for it), keeps Γ symmetric positive,
+// and a rigid translation feels the same substrate force as with the consistent blocks (Σ w = Σ β = 1).
+TEST(FrictionOperator, LumpedSubstrateFrictionIsBlockDiagonalAndKeepsRigidForces) {
+  FrictionSetup consistent(2), lumped(2);
+  const Eigen::MatrixXd without = lumped.assemble();
+  consistent.enable_random_substrate(5, false);
+  lumped.enable_random_substrate(5, true);
+  const Eigen::MatrixXd a = lumped.assemble(), b = consistent.assemble();
+  const Eigen::MatrixXd sub = a - without;
+  ASSERT_GT(sub.norm(), 0.0);
+  for (int i = 0; i < lumped.mesh.n_nodes; ++i)
+    for (int j = 0; j < lumped.mesh.n_nodes; ++j)
+      if (i != j) ASSERT_EQ((sub.block<3, 3>(3 * i, 3 * j).norm()), 0.0) << i << " " << j;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(sub, Eigen::EigenvaluesOnly);
+  EXPECT_GT(eig.eigenvalues().minCoeff(), -1e-12 * eig.eigenvalues().maxCoeff()) << "PSD despite β < 0";
+  const Vector v = lumped.random_vector(31);
+  const auto vh = to_host_vector(v), gv = to_host_vector(lumped.apply(v));
+  const Eigen::VectorXd expected = a * Eigen::Map<const Eigen::VectorXd>(vh.data(), vh.size());
+  EXPECT_LT((Eigen::Map<const Eigen::VectorXd>(gv.data(), gv.size()) - expected).norm(), 1e-12 * expected.norm());
+  // Net substrate force of a rigid translation u: Σ_i w_i Γ_t u = Γ_t u = (Σ_i β_i)(Σ_j β_j) Γ_t u.
+  Eigen::VectorXd u(a.rows());
+  for (int i = 0; i < lumped.mesh.n_nodes; ++i) u.segment<3>(3 * i) = Eigen::Vector3d(0.3, -0.5, 1.0);
+  const Eigen::VectorXd fa = (a - without) * u, fb = (b - without) * u;
+  Eigen::Vector3d ta = Eigen::Vector3d::Zero(), tb = Eigen::Vector3d::Zero();
+  for (int i = 0; i < lumped.mesh.n_nodes; ++i) {
+    ta += fa.segment<3>(3 * i);
+    tb += fb.segment<3>(3 * i);
+  }
+  EXPECT_LT((ta - tb).norm(), 1e-12 * tb.norm()) << "Σ_i w_i Γ_t u = Σ_ij β_i β_j Γ_t u = Γ_t u";
+}
+
 TEST(Pcg, AgreesWithEigenReferenceOn642Nodes) {
   const FrictionSetup s(3);  // 642 nodes, paper parameters
   const Eigen::MatrixXd a = s.assemble();

@@ -240,13 +240,14 @@ void run(const AppOptions& options, const SpreadOptions& so) {
       ts.push_back(t);
       rs.push_back(r_cc);
       next_sample = std::max(t * std::pow(10.0, 1.0 / per_decade), t + dt);
-      if (!options.quiet && seconds_since(last_progress) > 2.0) {
-        const double wall = seconds_since(wall0), rate = (step + 1) / wall;
-        std::printf("  t = %.4f s  r_cc = %.3f um  CG %d it  %.0f steps/s  ETA %.0f s\n", t, r_cc * 1e6,
-                    r.iterations, rate, (t_end - t) / dt / rate);
-        std::fflush(stdout);
-        last_progress = std::chrono::steady_clock::now();
-      }
+    }
+    // Progress every 2 s of wall time, independent of the (log-spaced) series rows.
+    if (!options.quiet && seconds_since(last_progress) > 2.0) {
+      const double wall = seconds_since(wall0), rate = (step + 1) / wall;
+      std::printf("  t = %.4f s  r_cc = %.3f um  CG %d it  %.0f steps/s  ETA %.0f s\n", t,
+                  std::sqrt(model.contact_area() / kPi) * 1e6, r.iterations, rate, (t_end - t) / dt / rate);
+      std::fflush(stdout);
+      last_progress = std::chrono::steady_clock::now();
     }
     t += h;
     if (h < dt) last = false;  // a halved step does not end the run early
