@@ -143,8 +143,15 @@ std::vector<ParamSpec> make_schema() {
           "extra friction on nodes whose triangles all lie fully in the contact (the paper's pinning; 0: "
           "off)"),
 
-      real_key("time.dt_s", "6e-6", 0, 1, kExcl, "s", "time step"),
+      real_key("time.dt_s", "6e-6", 0, 1, kExcl, "s", "time step (with time.adaptive: the first step)"),
       real_key("time.t_end_s", "1.2", 0, 1e6, kIncl, "s", "simulated time"),
+      bool_key("time.adaptive", "false",
+               "error-controlled time steps (Euler against Heun, docs/model/time_stepping.md); false: the "
+               "fixed time.dt_s of the paper"),
+      real_key("time.error_tol_m", "1e-9", 0, 1e-6, kExcl, "m",
+               "adaptive: allowed local position error per step"),
+      real_key("time.dt_min_s", "1e-9", 0, 1, kExcl, "s", "adaptive: smallest step"),
+      real_key("time.dt_max_s", "1e-3", 0, 1, kExcl, "s", "adaptive: largest step"),
 
       real_key("solver.cg_abs_tol_N", "1e-14", 0, 1e-6, kIncl, "N",
                "CG stops when the force residual ||F − Γv||₂ is below this (the paper's 1e-14 N) ..."),
@@ -162,6 +169,9 @@ std::vector<ParamSpec> make_schema() {
       bool_key("solver.implicit_bonds", "true",
                "the bonds' axial FENE+POW stiffness Δt k'(d) in the velocity solve: a bond near d_max cannot "
                "overshoot it (the paper's forward Euler: false)"),
+      bool_key("solver.implicit_tension", "true",
+               "the area terms' tension stiffness (out of the surface) in the velocity solve: a flat, tense "
+               "patch of cortex does not spike at the paper's Δt (solvers/tension_stiffness.hpp)"),
 
       string_key("output.dir", "", {}, "output directory (empty: out/<name>)"),
       bool_key("output.hdf5", "true", "write the HDF5 + XDMF output"),

@@ -52,6 +52,20 @@ KOKKOS_INLINE_FUNCTION double fene_pow_axial_stiffness(double d, double d_rest, 
   return k_s * (1 + d * d / d_max2) / (q * q) + 2 * k_c / (d * d * d);
 }
 
+// The stiffness a linearly implicit step uses for a bond (N/m): the larger of the tangent k'(d) and the
+// secant from d to half-way to d_max, (F(d_h) − F(d)) / (d_h − d), d_h = d + (d_max − d)/2. FENE stiffens
+// without bound, so a step with the tangent alone overshoots towards d_max when the bond is pulled from
+// below; with the secant, a pull up to F(d_h) − F(d) moves the bond at most half-way (in one dimension).
+KOKKOS_INLINE_FUNCTION double fene_pow_implicit_stiffness(double d, double d_rest, double k_s, double x_max) {
+  const double tangent = fene_pow_axial_stiffness(d, d_rest, k_s, x_max);
+  const double d_half = d + 0.5 * (x_max * d_rest - d);
+  if (!(d_half > d)) return tangent;
+  const double secant = (fene_pow_force_magnitude(d_half, d_rest, k_s, x_max) -
+                         fene_pow_force_magnitude(d, d_rest, k_s, x_max)) /
+                        (d_half - d);
+  return secant > tangent ? secant : tangent;
+}
+
 // U of one bond (J), eq. 21 + k_c / d; only for 0 < d < d_max.
 KOKKOS_INLINE_FUNCTION double fene_pow_bond_energy(double d, double d_rest, double k_s, double x_max) {
   const double d_max2 = x_max * x_max * d_rest * d_rest;

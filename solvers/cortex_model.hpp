@@ -31,6 +31,7 @@
 #include "solvers/global_stiffness.hpp"
 #include "solvers/multigrid.hpp"
 #include "solvers/pcg.hpp"
+#include "solvers/tension_stiffness.hpp"
 
 namespace dcm {
 
@@ -49,9 +50,10 @@ struct MechanicsParams {
   bool multigrid = false;         // V-cycle preconditioner (where the mesh has an icosphere hierarchy)
   bool implicit_bonds = false;    // the bonds' axial stiffness Δt k'(d) in the solve (stiff FENE near d_max)
   bool implicit_bending =
-      false;                  // bending's Gauss-Newton stiffness in the solve (solvers/bending_stiffness.hpp)
-  double gravity = 0;         // m/s², along −z (paper eq. 32's F_gravity); 0: no gravity term
-  double density_excess = 0;  // kg/m³, cell minus medium (buoyant weight Δρ V* g per cell)
+      false;  // bending's Gauss-Newton stiffness in the solve (solvers/bending_stiffness.hpp)
+  bool implicit_tension = false;  // the area terms' tension stiffness in the solve (tension_stiffness.hpp)
+  double gravity = 0;             // m/s², along −z (paper eq. 32's F_gravity); 0: no gravity term
+  double density_excess = 0;      // kg/m³, cell minus medium (buoyant weight Δρ V* g per cell)
   // A substrate plane with Maugis–Dugdale adhesion (kernels/plane_contact.hpp) and substrate friction
   // γ_n, γ_t (N·s/m³); no plane: no contact kernel runs.
   bool has_plane = false;
@@ -59,7 +61,8 @@ struct MechanicsParams {
   PlaneContactParams contact;
   double gamma_n = 0, gamma_t = 0;
   double pin_friction = 0;  // N·s/m on nodes fully in contact (the paper's pinning); 0: off
-  bool lumped_friction = true;  // substrate friction w_i Γ_t per node (false: β_i β_j Γ_t), friction_operator.hpp
+  bool lumped_friction =
+      true;  // substrate friction w_i Γ_t per node (false: β_i β_j Γ_t), friction_operator.hpp
 };
 
 // Index of the first node with a non-finite component, or -1.
@@ -99,6 +102,7 @@ class CortexModel {
     if (p.k_b > 0) hinges_ = make_hinge_rest(space_, mesh_);
     if (p.k_b > 0 && p.implicit_bending) bending_stiffness_ = BendingStiffness<Mem>(mesh_);
     if (p.k_area_local > 0 || p.k_area_global > 0) area_ = make_area_rest(space_, mesh_, geo_);
+    if (area_ && p.implicit_tension) tension_stiffness_ = TensionStiffness<Mem>(mesh_);
     if (p.k_volume > 0) volume_ = make_volume_rest(space_, mesh_, geo_);
     if (p.k_area_global > 0 || p.k_volume > 0)
       global_ = GlobalStiffness<Mem>(mesh_, p.k_area_global > 0, p.k_volume > 0);
@@ -202,9 +206,12 @@ class CortexModel {
   // linearly implicit, (Γ + dt K) v = F (solvers/global_stiffness.hpp, bending_stiffness.hpp); dt = 0 solves
   // Γ v = F. Without dashpots and implicit terms Γ is
   // diagonal and the solve is one multiplication per node.
-  // With params().implicit_bonds, the bonds' axial stiffness too (Δt k'(d_b) n̂n̂ᵀ per bond, added to the
-  // dashpot coefficient in the friction operator): a FENE bond close to d_max cannot overshoot it.
-  CgResult solve_velocity(const CgSettings& settings, double dt = 0) {
+  // With params().implicit_bonds, the bonds' axial stiffness too (Δt k n̂n̂ᵀ per bond, k the larger of the
+  // tangent and the secant to half-way to d_max, kernels/fene_pow_bonds.hpp; added to the dashpot
+  // coefficient in the friction operator): a FENE bond close to d_max does not overshoot it.
+  // With throw_if_unconverged = false a solve that reaches the iteration cap returns converged = false
+  // (the time stepper then retries with a shorter step; unconverged_message() says what happened).
+  CgResult solve_velocity(const CgSettings& settings, double dt = 0, bool throw_if_unconverged = true) {
     const bool implicit_bonds = dt > 0 && params_.implicit_bonds && bonds_.has_value();
     if (implicit_bonds) {
       if (friction_.bond_stiffness_dt.extent(0) == 0)
@@ -219,7 +226,7 @@ class CortexModel {
           "dcm::model::implicit_bonds", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_bonds),
           KOKKOS_LAMBDA(const int b) {
             const double d = norm(load3(x, bond(b, 1)) - load3(x, bond(b, 0)));
-            k_dt(b) = dt * fene_pow_axial_stiffness(d, rest(b), k_s, x_max);
+            k_dt(b) = dt * fene_pow_implicit_stiffness(d, rest(b), k_s, x_max);
           });
     } else {
       friction_.bond_stiffness_dt = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
@@ -230,12 +237,16 @@ class CortexModel {
     const bool implicit_bending = dt > 0 && bending_stiffness_.has_value();
     if (implicit_bending)
       update_bending_stiffness(space_, mesh_, *hinges_, params_.k_b, dt, *bending_stiffness_);
+    const bool implicit_tension = dt > 0 && tension_stiffness_.has_value();
+    if (implicit_tension)
+      update_tension_stiffness(space_, mesh_, geo_, *area_, params_.k_area_local, params_.k_area_global, dt,
+                               *tension_stiffness_);
     if (implicit)
       update_global_stiffness(space_, mesh_, geo_, area_ ? area_->cell_area : volume_->cell_volume,
                               volume_ ? volume_->cell_volume : area_->cell_area, params_.k_area_global,
                               params_.k_volume, dt, *global_);
     if (params_.dashpot == 0 && params_.dashpot_transverse == 0 && !friction_.substrate && !implicit &&
-        !implicit_bending && !implicit_bonds) {
+        !implicit_bending && !implicit_bonds && !implicit_tension) {
       apply_block_jacobi(space_, friction_, force_, velocity_);
       CgResult r;
       r.converged = true;
@@ -247,6 +258,7 @@ class CortexModel {
           apply_friction(space_, mesh_, friction_, in, out);
           if (implicit) apply_global_stiffness(space_, mesh_, *global_, in, out);
           if (implicit_bending) apply_bending_stiffness(space_, mesh_, *bending_stiffness_, in, out);
+          if (implicit_tension) apply_tension_stiffness(space_, mesh_, *tension_stiffness_, in, out);
         },
         [&](const Vector& in, const Vector& out) {
           if (multigrid_)
@@ -258,17 +270,7 @@ class CortexModel {
     if (!r.converged && !(r.residual_norm < INFINITY))
       throw NumericalError("conjugate gradients diverged (residual " + std::to_string(r.residual_norm) +
                            " N)");
-    if (!r.converged) {
-      char msg[200];
-      std::snprintf(
-          msg, sizeof msg,
-          "conjugate gradients did not converge in %d iterations (residual %.3g N, tolerance %.3g N); "
-          "raise solver.cg_max_iterations or solver.cg_rel_tol",
-          r.iterations, r.residual_norm,
-          settings.abs_tol > settings.rel_tol * r.rhs_norm ? settings.abs_tol
-                                                           : settings.rel_tol * r.rhs_norm);
-      throw NumericalError(msg);
-    }
+    if (!r.converged && throw_if_unconverged) throw NumericalError(unconverged_message(r, settings));
     const int bad = first_non_finite_node(space_, velocity_);
     if (bad >= 0)
       throw NumericalError("non-finite velocity at node " + std::to_string(bad) + " after the solve");
@@ -278,6 +280,18 @@ class CortexModel {
   // F · v: the rate at which the forces do work on the current velocity (W); with the explicit step it
   // equals the dissipation vᵀΓv, with the implicit global terms it is vᵀ(Γ + dt K)v.
   double power() { return cg_detail::dot(space_, force_, velocity_); }
+
+  static std::string unconverged_message(const CgResult& r, const CgSettings& settings) {
+    char msg[300];
+    std::snprintf(
+        msg, sizeof msg,
+        "conjugate gradients did not converge in %d iterations (residual %.3g N, tolerance %.3g N, "
+        "|F| = %.3g N); raise solver.cg_max_iterations or solver.cg_rel_tol",
+        r.iterations, r.residual_norm,
+        settings.abs_tol > settings.rel_tol * r.rhs_norm ? settings.abs_tol : settings.rel_tol * r.rhs_norm,
+        r.rhs_norm);
+    return msg;
+  }
 
   // x += dt v (forward Euler, paper eq. 32 integrated explicitly).
   void advance(double dt) {
@@ -388,6 +402,7 @@ class CortexModel {
   std::optional<GlobalStiffness<Mem>> global_;
   std::optional<Multigrid<Mem>> multigrid_;
   std::optional<BendingStiffness<Mem>> bending_stiffness_;
+  std::optional<TensionStiffness<Mem>> tension_stiffness_;
   std::optional<Vector> gravity_;
   std::optional<ContactBuffers<Mem>> contact_;
   FrictionOperator<Mem> friction_;

@@ -88,7 +88,8 @@ template <class MemorySpace>
 void enable_substrate_friction(FrictionOperator<MemorySpace>& op, const ContactBuffers<MemorySpace>& contact,
                                double gamma_n, double gamma_t, Real3 normal, double pin_friction = 0,
                                bool lumped = false) {
-  enable_substrate_friction(op, contact.tri_beta, contact.tri_friction_area, gamma_n, gamma_t, normal, lumped);
+  enable_substrate_friction(op, contact.tri_beta, contact.tri_friction_area, gamma_n, gamma_t, normal,
+                            lumped);
   op.pin_friction = pin_friction;
   op.tri_regime = contact.tri_regime;
 }
@@ -287,7 +288,8 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
             const int t = corners(k) / 3;
             const double area = contact_area(t);
             if (area > 0)
-              acc += substrate_block_times(sn, lumped_weight(beta, t, corners(k) % 3) * area, gamma_n, gamma_t, vi);
+              acc += substrate_block_times(sn, lumped_weight(beta, t, corners(k) % 3) * area, gamma_n,
+                                           gamma_t, vi);
           }
         } else if (substrate) {
           for (int k = tri_offsets(i); k < tri_offsets(i + 1); ++k) {

@@ -394,3 +394,28 @@ TEST(FenePow, AxialStiffnessIsTheDerivativeOfTheForce) {
 }
 }  // namespace
 }  // namespace dcm
+
+namespace dcm {
+namespace {
+// The implicit step's stiffness is at least the tangent and at least the secant to half-way to d_max: a
+// 1D bond pulled by a constant force F_pull from a length where F(d) < F_pull, stepped with (c/Δt + k) Δd =
+// F_pull − F(d), never passes the half-way point as long as F_pull ≤ F(d_h), and so never reaches d_max.
+TEST(FenePow, ImplicitStiffnessBoundsTheStepToHalfWay) {
+  const double k_s = 3.2e-6, x_max = 2.05, d0 = 0.25e-6, d_max = x_max * d0;
+  for (double s : {1.0, 1.5, 1.9, 2.0, 2.04}) {
+    const double d = s * d0, d_half = d + 0.5 * (d_max - d);
+    const double k = fene_pow_implicit_stiffness(d, d0, k_s, x_max);
+    EXPECT_GE(k, fene_pow_axial_stiffness(d, d0, k_s, x_max));
+    const double pull = fene_pow_force_magnitude(d_half, d0, k_s, x_max);  // the largest pull covered
+    const double step = (pull - fene_pow_force_magnitude(d, d0, k_s, x_max)) / k;
+    EXPECT_LE(d + step, d_half * (1 + 1e-12)) << "stretch " << s;
+    // With the tangent alone the same pull overshoots d_max near the singularity.
+    if (s >= 1.9) {
+      const double tangent_step =
+          (pull - fene_pow_force_magnitude(d, d0, k_s, x_max)) / fene_pow_axial_stiffness(d, d0, k_s, x_max);
+      EXPECT_GT(d + tangent_step, d_half) << "stretch " << s;
+    }
+  }
+}
+}  // namespace
+}  // namespace dcm

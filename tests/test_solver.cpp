@@ -127,7 +127,8 @@ TEST(FrictionOperator, LumpedSubstrateFrictionIsBlockDiagonalAndKeepsRigidForces
   const Vector v = lumped.random_vector(31);
   const auto vh = to_host_vector(v), gv = to_host_vector(lumped.apply(v));
   const Eigen::VectorXd expected = a * Eigen::Map<const Eigen::VectorXd>(vh.data(), vh.size());
-  EXPECT_LT((Eigen::Map<const Eigen::VectorXd>(gv.data(), gv.size()) - expected).norm(), 1e-12 * expected.norm());
+  EXPECT_LT((Eigen::Map<const Eigen::VectorXd>(gv.data(), gv.size()) - expected).norm(),
+            1e-12 * expected.norm());
   // Net substrate force of a rigid translation u: Σ_i w_i Γ_t u = Γ_t u = (Σ_i β_i)(Σ_j β_j) Γ_t u.
   Eigen::VectorXd u(a.rows());
   for (int i = 0; i < lumped.mesh.n_nodes; ++i) u.segment<3>(3 * i) = Eigen::Vector3d(0.3, -0.5, 1.0);

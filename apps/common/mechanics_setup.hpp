@@ -7,6 +7,7 @@
 #include "core/host_mesh.hpp"
 #include "core/scene.hpp"
 #include "solvers/cortex_model.hpp"
+#include "solvers/time_stepper.hpp"
 
 namespace dcm {
 
@@ -28,6 +29,7 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
   p.multigrid = scene.get_string("solver.preconditioner") == "multigrid";
   p.implicit_bending = scene.get_bool("solver.implicit_bending");
   p.implicit_bonds = scene.get_bool("solver.implicit_bonds");
+  p.implicit_tension = scene.get_bool("solver.implicit_tension");
   p.gravity = scene.get_real("body.gravity_m_per_s2");
   p.density_excess = scene.get_real("body.density_excess_kg_per_m3");
   p.has_plane = scene.get_bool("contact.plane");
@@ -54,6 +56,22 @@ inline HostMesh cell_mesh_from_scene(const Scene& scene) {
     return make_evans_fung(k, ef);
   }
   return make_icosphere(k, scene.get_real("mesh.radius_m"));
+}
+
+// The time-step settings (time.*). dt_min ≤ dt ≤ dt_max is checked here (one line naming the keys).
+inline TimeStepSettings steps_from_scene(const Scene& scene) {
+  TimeStepSettings s;
+  s.dt = scene.get_real("time.dt_s");
+  s.adaptive = scene.get_bool("time.adaptive");
+  s.error_tol_m = scene.get_real("time.error_tol_m");
+  s.dt_min = scene.get_real("time.dt_min_s");
+  s.dt_max = scene.get_real("time.dt_max_s");
+  if (s.adaptive && !(s.dt_min <= s.dt && s.dt <= s.dt_max))
+    throw SceneError("time.dt_s = " + std::to_string(s.dt) +
+                     " is not allowed with time.adaptive = true: it must "
+                     "lie in [time.dt_min_s, time.dt_max_s] = [" +
+                     std::to_string(s.dt_min) + ", " + std::to_string(s.dt_max) + "]");
+  return s;
 }
 
 inline CgSettings cg_settings_from_scene(const Scene& scene) {

@@ -30,6 +30,7 @@
 #include "core/host_copy.hpp"
 #include "core/json_writer.hpp"
 #include "core/kokkos_compat.hpp"
+#include "solvers/time_stepper.hpp"
 
 namespace dcm {
 namespace {
@@ -126,7 +127,7 @@ void run(const AppOptions& options, const SpreadOptions& so) {
   NodeFields<Exec::memory_space> fields(n);
 
   const double dt = scene.get_real("time.dt_s"), t_end = scene.get_real("time.t_end_s");
-  const long long steps = std::llround(t_end / dt);
+  const long long steps = std::llround(t_end / dt);  // fixed steps; adaptive ones are counted as they go
   const double frame_every = scene.get_real("output.frame_every_s");
   const double per_decade = static_cast<double>(scene.get_int("output.series_per_decade"));
   const CgSettings cg = cg_settings_from_scene(scene);
@@ -167,60 +168,53 @@ void run(const AppOptions& options, const SpreadOptions& so) {
                     {"normal_pressure_Pa", 1, pn.data()}});
   };
 
-  // Fixed Δt (the paper's forward Euler); a step that would take a bond too close to d_max is taken again
-  // with Δt/2 (up to 20 times): the FENE singularity is never crossed (docs/model/spread.md).
-  FrictionOperator<Exec::memory_space>::Vector x_saved("dcm::spread::x_saved", n);
-  long long halved_steps = 0;
-  double t = 0;
-  bool last = false;
-  for (; !last; ++step) {
-    last = t + 1.5 * dt > t_end;
-    CgResult r;
-    double h = dt;
+  // Forward Euler at the scene's fixed Δt (the paper's) or with adaptive, error-controlled steps; a step
+  // that would take a bond too close to d_max is taken again with half the step (solvers/time_stepper.hpp).
+  TimeStepper<Exec> stepper(n, steps_from_scene(scene));
+  long long halved_steps = 0, rejected_steps = 0;
+  double h_min = INFINITY, h_max = 0;
+  for (bool last = false; !last; ++step) {
+    const double t = stepper.time();
+    // The last step lands on t_end (a fixed-step run's last step may be up to 1.5 Δt long, as before).
+    const double remaining = t_end - t;
+    const double h_cap =
+        stepper.settings().adaptive ? remaining : (remaining < 1.5 * dt ? remaining : INFINITY);
     double e0 = 0, pc = 0, dis = 0;
     bool sample = false;
+    StepReport rep;
     try {
-      model.compute_forces();
-      const bool figure = next_figure < figure_times.size() && t + 0.5 * dt >= figure_times[next_figure];
-      if (t >= next_frame - 0.5 * dt || figure || last) {
-        write_frame(t);
-        while (next_frame <= t + 0.5 * dt) next_frame += frame_every;
-        while (next_figure < figure_times.size() && figure_times[next_figure] <= t + 0.5 * dt) ++next_figure;
-      }
-      Kokkos::deep_copy(x_saved, model.positions());
-      // A step may take the most extended bond at most half-way from its length to d_max (and always to
-      // 0.999 d_max): bonds approach x_max, as the paper's spread cells do, but never cross it.
-      const double ext_start = model.max_bond_extension();
-      const double ext_limit = std::max(0.999, ext_start + 0.5 * (1.0 - ext_start));
-      for (int halving = 0;; ++halving) {
-        r = model.solve_velocity(cg, h);
-        cg_total += r.iterations;
-        cg_max = std::max(cg_max, r.iterations);
-        sample = t >= next_sample || last || step < 10;
+      rep = stepper.step(model, cg, h_cap, [&](double h_planned) {
+        if (t >= next_frame - 1e-12 ||
+            (next_figure < figure_times.size() && t >= figure_times[next_figure] - 1e-12)) {
+          write_frame(t);
+          while (next_frame <= t + 1e-12) next_frame += frame_every;
+          while (next_figure < figure_times.size() && figure_times[next_figure] <= t + 1e-12) ++next_figure;
+        }
+        sample = t >= next_sample || step < 10 || h_planned >= h_cap;
         if (sample) {
           e0 = model.energy();
           pc = model.contact_power();
           dis = model.dissipation();
         }
-        model.advance(h);
-        if (model.max_bond_extension() < ext_limit) break;
-        if (halving == 20)
-          throw NumericalError(
-              "a bond stays at its maximum length d_max even with the time step halved 20 times");
-        Kokkos::deep_copy(model.positions(), x_saved);
-        h *= 0.5;
-        ++halved_steps;
-      }
+      });
     } catch (const NumericalError& e) {
       h5.close();  // what was done stays readable
       csv.close();
       std::rename(csv_tmp.c_str(), (out + "/series.csv").c_str());
-      throw NumericalError("step " + std::to_string(step) + " (t = " + std::to_string(t) +
+      throw NumericalError("step " + std::to_string(step) + " (t = " + std::to_string(stepper.time()) +
                            " s): " + e.what() + " — try a smaller time.dt_s");
     }
+    const double h = rep.h;
+    last = stepper.time() >= t_end * (1 - 1e-12);
+    cg_total += rep.iterations;
+    cg_max = std::max(cg_max, rep.iterations);
+    halved_steps += rep.halvings;
+    rejected_steps += rep.rejections;
+    h_min = std::min(h_min, h);
+    h_max = std::max(h_max, h);
     if (sample) {
       // Energy balance of the step: (E(t+h) − E(t))/h against the contact power minus the dissipation.
-      const double de = (model.energy() - e0) / h, residual = de - (pc - dis);
+      const double e1 = model.energy(), de = (e1 - e0) / h, residual = de - (pc - dis);
       worst_residual = std::max(worst_residual, std::fabs(residual));
       worst_residual_scale = std::max(worst_residual_scale, std::fabs(dis) + std::fabs(pc));
       const double area_c = model.contact_area(), r_cc = std::sqrt(area_c / kPi);
@@ -231,34 +225,34 @@ void run(const AppOptions& options, const SpreadOptions& so) {
       const double volume = to_host_vector(model.geometry().cell_volume)[0];
       char line[512];
       std::snprintf(line, sizeof line,
-                    "%.9g,%.9g,%.9g,%.9g,%.9g,%d,%.6g,%.9g,%.9g,%.12g,%.6g,%.6g,%.6g,%.6g\n", t, r_cc, area_c,
-                    area, volume, r.iterations, h, ztop - plane_z, model.contact_load(), e0, de, pc, dis,
-                    residual);
+                    "%.9g,%.9g,%.9g,%.9g,%.9g,%d,%.6g,%.9g,%.9g,%.12g,%.6g,%.6g,%.6g,%.6g\n", t + h, r_cc,
+                    area_c, area, volume, rep.iterations, h, ztop - plane_z, model.contact_load(), e1, de, pc,
+                    dis, residual);
       csv << line;
       h5.append_series(
-          {{"t_s", t}, {"r_cc_m", r_cc}, {"contact_area_m2", area_c}, {"height_m", ztop - plane_z}});
-      ts.push_back(t);
+          {{"t_s", t + h}, {"r_cc_m", r_cc}, {"contact_area_m2", area_c}, {"height_m", ztop - plane_z}});
+      ts.push_back(t + h);
       rs.push_back(r_cc);
-      next_sample = std::max(t * std::pow(10.0, 1.0 / per_decade), t + dt);
+      next_sample = (t + h) * std::pow(10.0, 1.0 / per_decade);
     }
     // Progress every 2 s of wall time, independent of the (log-spaced) series rows.
     if (!options.quiet && seconds_since(last_progress) > 2.0) {
       const double wall = seconds_since(wall0), rate = (step + 1) / wall;
-      std::printf("  t = %.4f s  r_cc = %.3f um  CG %d it  %.0f steps/s  ETA %.0f s\n", t,
-                  std::sqrt(model.contact_area() / kPi) * 1e6, r.iterations, rate, (t_end - t) / dt / rate);
+      std::printf("  t = %.4f s  r_cc = %.3f um  dt = %.2g s  CG %d it  %.0f steps/s  ETA %.0f s\n",
+                  stepper.time(), std::sqrt(model.contact_area() / kPi) * 1e6, h, rep.iterations, rate,
+                  (t_end - stepper.time()) / h / rate);
       std::fflush(stdout);
       last_progress = std::chrono::steady_clock::now();
     }
-    t += h;
-    if (h < dt) last = false;  // a halved step does not end the run early
-    if (g_stop) {
-      interrupted = true;
+    if (g_stop || last) {
+      interrupted = !last;
       model.compute_forces();
-      write_frame(t);
+      write_frame(stepper.time());  // the final state
       ++step;
       break;
     }
   }
+  const double t = stepper.time();
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
   csv.close();
@@ -279,6 +273,10 @@ void run(const AppOptions& options, const SpreadOptions& so) {
       .add("interrupted", interrupted)
       .add("t_end_s", t)
       .add("halved_steps", halved_steps)
+      .add("rejected_steps", rejected_steps)
+      .add("adaptive", stepper.settings().adaptive)
+      .add("dt_min_taken_s", std::isfinite(h_min) ? h_min : 0.0)
+      .add("dt_max_taken_s", h_max)
       .add("r_cc_final_m", rs.empty() ? 0.0 : rs.back())
       .add("contact_angle_deg", cap.angle_deg)
       .add("cap_radius_m", cap.radius)
