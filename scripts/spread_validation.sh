@@ -16,23 +16,24 @@ run() {  # name, then the spread arguments
   echo "== $name: $*"
   OMP_NUM_THREADS=1 "$spread" "$@" --quiet --out "$out/$name" > "$out/$name.log" 2>&1 || echo "   $name failed: $(tail -n 1 "$out/$name.log")"
 }
-# The 2562-node runs cost ~25 ms per step on one thread (35 steps/s): the Hategan case is run to 0.6 s here
-# (its spreading has levelled off by then at 642 nodes), the biconcave comparison on 642 nodes.
+# Session 3 defaults (lumped substrate friction, implicit tension): a 642-node 1.2 s run takes ~10 min and
+# the 2562-node one ~25 min on one thread here. The Figure 5 runs use adaptive steps (tolerance 1e-9 m; its
+# error is measured by perf/work_precision.py, docs/PERFORMANCE.md).
 queue1() {
-  run hategan2004_sphered scenes/hategan2004_sphered.toml --set time.t_end_s=0.6
-  run hategan2004_biconcave_642 scenes/hategan2004_biconcave.toml --set mesh.nodes=642 --set time.t_end_s=0.6
+  run hategan2004_sphered scenes/hategan2004_sphered.toml
+  run hategan2004_biconcave_642 scenes/hategan2004_biconcave.toml --set mesh.nodes=642
+  run cuvelier2007 scenes/cuvelier2007.toml --set time.adaptive=true --set time.error_tol_m=1e-9
 }
 queue2() {
   local base=(scenes/hategan2004_sphered.toml --set mesh.nodes=642)
   run hategan2004_sphered_642 "${base[@]}"
-  local short=("${base[@]}" --set time.t_end_s=0.3)
-  run fig5_reference "${short[@]}"
-  run fig5_W_x2 "${short[@]}" --set contact.W_J_per_m2=2e-3
-  run fig5_gamma_n_half "${short[@]}" --set contact.gamma_n_N_s_per_m3=4e9
-  run fig5_k_b_x2 "${short[@]}" --set cortex.k_b_J=480e-21
-  run fig5_x_max_2.5 "${short[@]}" --set cortex.x_max=2.5
-  run fig5_k_a_2e-3 "${short[@]}" --set cortex.k_a=2e-3
-  run cuvelier2007 scenes/cuvelier2007.toml --set time.t_end_s=10
+  local fig5=("${base[@]}" --set time.adaptive=true --set time.error_tol_m=1e-9)
+  run fig5_reference "${fig5[@]}"
+  run fig5_W_x2 "${fig5[@]}" --set contact.W_J_per_m2=2e-3
+  run fig5_gamma_n_half "${fig5[@]}" --set contact.gamma_n_N_s_per_m3=4e9
+  run fig5_k_b_x2 "${fig5[@]}" --set cortex.k_b_J=480e-21
+  run fig5_x_max_2.5 "${fig5[@]}" --set cortex.x_max=2.5
+  run fig5_k_a_2e-3 "${fig5[@]}" --set cortex.k_a=2e-3
 }
 case "${1:-both}" in
   1) queue1 ;;
