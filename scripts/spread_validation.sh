@@ -22,7 +22,7 @@ run() {  # name, then the spread arguments
 queue1() {
   run hategan2004_sphered scenes/hategan2004_sphered.toml
   run hategan2004_biconcave_642 scenes/hategan2004_biconcave.toml --set mesh.nodes=642
-  run cuvelier2007 scenes/cuvelier2007.toml --set time.adaptive=true --set time.error_tol_m=1e-9
+  run cuvelier2007 scenes/cuvelier2007.toml --set time.adaptive=true --set time.error_tol_m=1e-9 --early-window-s 2,20
 }
 queue2() {
   local base=(scenes/hategan2004_sphered.toml --set mesh.nodes=642)
