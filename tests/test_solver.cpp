@@ -121,7 +121,9 @@ TEST(FrictionOperator, LumpedSubstrateFrictionIsBlockDiagonalAndKeepsRigidForces
   ASSERT_GT(sub.norm(), 0.0);
   for (int i = 0; i < lumped.mesh.n_nodes; ++i)
     for (int j = 0; j < lumped.mesh.n_nodes; ++j)
-      if (i != j) ASSERT_EQ((sub.block<3, 3>(3 * i, 3 * j).norm()), 0.0) << i << " " << j;
+      if (i != j) {
+        ASSERT_EQ((sub.block<3, 3>(3 * i, 3 * j).norm()), 0.0) << i << " " << j;
+      }
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(sub, Eigen::EigenvaluesOnly);
   EXPECT_GT(eig.eigenvalues().minCoeff(), -1e-12 * eig.eigenvalues().maxCoeff()) << "PSD despite β < 0";
   const Vector v = lumped.random_vector(31);
