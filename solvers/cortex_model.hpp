@@ -232,15 +232,18 @@ class CortexModel {
       friction_.bond_stiffness_dt = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
     }
     update_friction(space_, mesh_, friction_);
-    if (multigrid_) update_multigrid(space_, mesh_, friction_, *multigrid_);
-    const bool implicit = dt > 0 && global_.has_value();
-    const bool implicit_bending = dt > 0 && bending_stiffness_.has_value();
-    if (implicit_bending)
-      update_bending_stiffness(space_, mesh_, *hinges_, params_.k_b, dt, *bending_stiffness_);
     const bool implicit_tension = dt > 0 && tension_stiffness_.has_value();
     if (implicit_tension)
       update_tension_stiffness(space_, mesh_, geo_, *area_, params_.k_area_local, params_.k_area_global, dt,
                                *tension_stiffness_);
+    // The multigrid's fine level holds Γ, the implicit bonds and the implicit tension (same sparsity).
+    if (multigrid_)
+      update_multigrid(space_, mesh_, friction_, *multigrid_,
+                       implicit_tension ? &*tension_stiffness_ : nullptr);
+    const bool implicit = dt > 0 && global_.has_value();
+    const bool implicit_bending = dt > 0 && bending_stiffness_.has_value();
+    if (implicit_bending)
+      update_bending_stiffness(space_, mesh_, *hinges_, params_.k_b, dt, *bending_stiffness_);
     if (implicit)
       update_global_stiffness(space_, mesh_, geo_, area_ ? area_->cell_area : volume_->cell_volume,
                               volume_ ? volume_->cell_volume : area_->cell_area, params_.k_area_global,

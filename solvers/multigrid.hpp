@@ -26,6 +26,7 @@
 #include "solvers/block_sparse.hpp"
 #include "solvers/friction_operator.hpp"
 #include "solvers/multigrid_setup.hpp"
+#include "solvers/tension_stiffness.hpp"
 
 namespace dcm {
 
@@ -184,7 +185,8 @@ Multigrid<MemorySpace> make_multigrid(const std::vector<HostCell>& cells,
 // Numeric set-up, once per step after update_friction(space, mesh, op).
 template <class ExecutionSpace, class MemorySpace>
 void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                      const FrictionOperator<MemorySpace>& op, Multigrid<MemorySpace>& mg) {
+                      const FrictionOperator<MemorySpace>& op, Multigrid<MemorySpace>& mg,
+                      const TensionStiffness<MemorySpace>* tension = nullptr) {
   {  // level 0: Γ's blocks, ζ_i I + Σ_b c n̂n̂ᵀ on the diagonal, −c n̂n̂ᵀ for each bond
     const BlockCsr<MemorySpace>& a = mg.levels[0].a;
     const auto off = a.row_offsets;
@@ -201,6 +203,14 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
     const auto substrate = substrate_blocks(mesh, op);
     const auto bond_k = op.bond_stiffness_dt;
     const bool stiff = bond_k.extent(0) > 0;
+    // The implicit tension blocks (ê_i · ê_j) n_t n_tᵀ (solvers/tension_stiffness.hpp) lie on the same
+    // pattern.
+    const bool with_tension = tension != nullptr;
+    const auto t_edge = with_tension ? tension->edge : decltype(tension->edge)();
+    const auto t_normal = with_tension ? tension->normal : decltype(tension->normal)();
+    const auto tri = mesh.tri;
+    const auto tri_offsets = mesh.node_tri_offsets;
+    const auto tri_corners = mesh.node_tri_corners;
     Kokkos::parallel_for(
         "dcm::mg::assemble_fine", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows),
         KOKKOS_LAMBDA(const int i) {
@@ -215,6 +225,22 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
               add_dashpot_block(load3(dir, bb), c + (stiff ? bond_k(bb) : 0.0), c_t, sign, blk);
             }
             substrate.add_block(i, cols(s), blk);
+            if (with_tension)
+              for (int q = tri_offsets(i); q < tri_offsets(i + 1); ++q) {
+                const int t = tri_corners(q) / 3, ci = tri_corners(q) % 3;
+                for (int cj = 0; cj < 3; ++cj) {
+                  if (tri(t, cj) != cols(s)) continue;
+                  const double w = t_edge(t, ci, 0) * t_edge(t, cj, 0) + t_edge(t, ci, 1) * t_edge(t, cj, 1) +
+                                   t_edge(t, ci, 2) * t_edge(t, cj, 2);
+                  const double nx = t_normal(t, 0), ny = t_normal(t, 1), nz = t_normal(t, 2);
+                  blk[0] += w * nx * nx;
+                  blk[1] += w * ny * ny;
+                  blk[2] += w * nz * nz;
+                  blk[3] += w * nx * ny;
+                  blk[4] += w * nx * nz;
+                  blk[5] += w * ny * nz;
+                }
+              }
             for (int k = 0; k < 6; ++k) val(s, k) = blk[k];
           }
         });

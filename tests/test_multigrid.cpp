@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "core/host_copy.hpp"
+#include "core/update_geometry.hpp"
 #include "solvers/multigrid.hpp"
 #include "solvers/pcg.hpp"
 #include "solvers/rigid_modes.hpp"
@@ -130,6 +131,54 @@ TEST(Multigrid, CoarseOperatorsAreGalerkinProducts) {
     EXPECT_LT((coarse - expected).norm(), 1e-12 * expected.norm()) << "level " << l + 1;
     fine = coarse;
   }
+}
+
+// The fine level also holds the implicit tension blocks Δt σ⁺ L_t ⊗ n nᵀ (solvers/tension_stiffness.hpp):
+// on a cell 10% larger than its rest state (tense), level 0 equals Γ plus the tension operator applied
+// column by column, and that operator is symmetric, positive semi-definite and blind to translations.
+TEST(Multigrid, FineLevelHoldsTheImplicitTension) {
+  Preconditioned s({2});
+  GeometryBuffers<Mem> geo(s.mesh);
+  update_geometry(Exec(), s.mesh, geo, 1e4);
+  const AreaRest<Mem> rest = make_area_rest(Exec(), s.mesh, geo);
+  {
+    auto x = Kokkos::create_mirror_view(s.mesh.x);
+    Kokkos::deep_copy(x, s.mesh.x);
+    for (std::size_t i = 0; i < x.extent(0); ++i)
+      for (int d = 0; d < 3; ++d) x(i, d) *= 1.1;
+    Kokkos::deep_copy(s.mesh.x, x);
+  }
+  update_geometry(Exec(), s.mesh, geo, 1e4);
+  update_friction(Exec(), s.mesh, s.op);
+  TensionStiffness<Mem> ts(s.mesh);
+  update_tension_stiffness(Exec(), s.mesh, geo, rest, 6e-3, 6e-3, 1e-4, ts);
+  update_multigrid(Exec(), s.mesh, s.op, s.mg, &ts);
+  const int n = s.mesh.n_nodes;
+  Eigen::MatrixXd k = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  for (int c = 0; c < 3 * n; ++c) {
+    Vector e("e", n), out("out", n);
+    Kokkos::deep_copy(Kokkos::subview(e, c / 3, c % 3), 1.0);
+    apply_tension_stiffness(Exec(), s.mesh, ts, e, out);
+    const auto col = to_host_vector(out);
+    for (int r = 0; r < 3 * n; ++r) k(r, c) = col[r];
+  }
+  ASSERT_GT(k.norm(), 0.0) << "the stretched cell is under tension";
+  EXPECT_LT((k - k.transpose()).norm(), 1e-12 * k.norm());
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(k, Eigen::EigenvaluesOnly);
+  EXPECT_GT(eig.eigenvalues().minCoeff(), -1e-12 * eig.eigenvalues().maxCoeff());
+  Eigen::VectorXd shift(3 * n);
+  for (int i = 0; i < n; ++i) shift.segment<3>(3 * i) = Eigen::Vector3d(0.3, -0.2, 0.9);
+  EXPECT_LT((k * shift).norm(), 1e-12 * k.norm() * shift.norm());
+  const auto off = to_host_vector(s.mg.levels[0].a.row_offsets), cols = to_host_vector(s.mg.levels[0].a.cols);
+  const auto v = to_host_vector(s.mg.levels[0].a.values);
+  Eigen::MatrixXd fine = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  for (int i = 0; i < n; ++i)
+    for (int q = off[i]; q < off[i + 1]; ++q) {
+      const double* b = &v[6 * q];
+      fine.block<3, 3>(3 * i, 3 * cols[q]) << b[0], b[3], b[4], b[3], b[1], b[5], b[4], b[5], b[2];
+    }
+  const Eigen::MatrixXd expected = s.assemble() + k;
+  EXPECT_LT((fine - expected).norm(), 1e-12 * expected.norm());
 }
 
 TEST(Multigrid, VCycleIsSymmetricAndPositive) {
