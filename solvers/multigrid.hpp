@@ -232,13 +232,7 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
                   if (tri(t, cj) != cols(s)) continue;
                   const double w = t_edge(t, ci, 0) * t_edge(t, cj, 0) + t_edge(t, ci, 1) * t_edge(t, cj, 1) +
                                    t_edge(t, ci, 2) * t_edge(t, cj, 2);
-                  const double nx = t_normal(t, 0), ny = t_normal(t, 1), nz = t_normal(t, 2);
-                  blk[0] += w * nx * nx;
-                  blk[1] += w * ny * ny;
-                  blk[2] += w * nz * nz;
-                  blk[3] += w * nx * ny;
-                  blk[4] += w * nx * nz;
-                  blk[5] += w * ny * nz;
+                  add_dashpot_block(load3(t_normal, t), w, 0.0, 1.0, blk);  // w n_t n_tᵀ
                 }
               }
             for (int k = 0; k < 6; ++k) val(s, k) = blk[k];
