@@ -10,4 +10,10 @@ struct NumericalError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A file that cannot be read or written (output folder, HDF5 output, checkpoint); the message names the
+// file. Exit code 2.
+struct IoError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 }  // namespace dcm

@@ -302,6 +302,93 @@ H5Output::H5Output(const std::string& h5_path) : impl_(nullptr), h5_path_(h5_pat
   impl_ = impl.release();
 }
 
+namespace {
+
+std::vector<std::string> link_names(hid_t group) {
+  std::vector<std::string> names;
+  H5Literate(
+      group, H5_INDEX_NAME, H5_ITER_INC, nullptr,
+      [](hid_t, const char* name, const H5L_info_t*, void* data) -> herr_t {
+        static_cast<std::vector<std::string>*>(data)->emplace_back(name);
+        return 0;
+      },
+      &names);
+  return names;
+}
+
+// Dimensions of a dataset (empty if it cannot be read).
+std::vector<hsize_t> dataset_dims(hid_t loc, const std::string& name) {
+  const hid_t set = H5Dopen2(loc, name.c_str(), H5P_DEFAULT);
+  if (set < 0) return {};
+  const hid_t space = H5Dget_space(set);
+  std::vector<hsize_t> dims;
+  const int rank = space < 0 ? -1 : H5Sget_simple_extent_ndims(space);
+  if (rank > 0) {
+    dims.resize(static_cast<std::size_t>(rank));
+    H5Sget_simple_extent_dims(space, dims.data(), nullptr);
+  }
+  if (space >= 0) H5Sclose(space);
+  H5Dclose(set);
+  return dims;
+}
+
+}  // namespace
+
+H5Output::H5Output(const std::string& h5_path, Resume resume) : impl_(nullptr), h5_path_(h5_path) {
+  xdmf_path_ = fs::path(h5_path).replace_extension(".xmf").string();
+  auto impl = std::make_unique<Impl>();
+  impl->path = h5_path;
+  impl->h5_name = fs::path(h5_path).filename().string();
+  impl->xdmf_path = xdmf_path_;
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  std::error_code ec;
+  if (!fs::is_regular_file(h5_path, ec)) impl->fail("cannot continue: the file of the run is missing");
+  const hid_t id = H5Fopen(h5_path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  if (id < 0) impl->fail("cannot continue the file (" + create_failure_reason(h5_path) + ")");
+  Impl& m = *impl;
+  m.file = Hid(id, H5Fclose);
+  const std::vector<hsize_t> x = dataset_dims(id, "/mesh/x"), tris = dataset_dims(id, "/mesh/triangles");
+  if (x.size() != 2 || tris.size() != 2 || !m.link_exists("/frames"))
+    m.fail("cannot continue: not a file written by dcm (no /mesh or /frames)");
+  m.n_nodes = static_cast<int>(x[0]);
+  m.n_tris = static_cast<int>(tris[0]);
+  m.has_mesh = true;
+  Hid frames = m.make(H5Gopen2(id, "/frames", H5P_DEFAULT), H5Gclose, "cannot open /frames");
+  const std::vector<std::string> names = link_names(frames.get());
+  if (static_cast<int>(names.size()) < resume.keep_frames)
+    m.fail("cannot continue: it holds " + std::to_string(names.size()) + " frames, the checkpoint " +
+           std::to_string(resume.keep_frames));
+  for (int i = 0; i < static_cast<int>(names.size()); ++i) {
+    const std::string group_name = frame_group_name(i);
+    if (i >= resume.keep_frames) {
+      m.checked(H5Ldelete(id, group_name.c_str(), H5P_DEFAULT), "cannot delete " + group_name);
+      continue;
+    }
+    Hid group = m.make(H5Gopen2(id, group_name.c_str(), H5P_DEFAULT), H5Gclose, "cannot open " + group_name);
+    double time = 0;
+    {
+      Hid attr = m.make(H5Aopen(group.get(), "time", H5P_DEFAULT), H5Aclose, "no time on " + group_name);
+      m.checked(H5Aread(attr.get(), H5T_NATIVE_DOUBLE, &time), "cannot read the time of " + group_name);
+    }
+    std::string attributes;
+    for (const std::string& field : link_names(group.get())) {
+      if (field == "x") continue;
+      const std::vector<hsize_t> dims = dataset_dims(group.get(), field);
+      const int components = dims.size() == 2 ? static_cast<int>(dims[1]) : 1;
+      attributes += m.attribute_xml(field, group_name + "/" + field, components, false);
+    }
+    const std::string time_text = format_double(time);
+    m.frames_xml += m.grid_xml("frame_" + group_name.substr(8), group_name + "/x", &time_text, attributes);
+  }
+  m.n_frames = resume.keep_frames;
+  if (m.link_exists("/series")) m.checked(H5Ldelete(id, "/series", H5P_DEFAULT), "cannot reset /series");
+  m.checked(H5Fflush(id, H5F_SCOPE_LOCAL), "cannot flush file");
+  m.write_xdmf();
+  impl_ = impl.release();
+}
+
+int H5Output::frames() const { return impl_->n_frames; }
+
 H5Output::~H5Output() {
   try {
     close();

@@ -19,11 +19,9 @@
 #include <utility>
 #include <vector>
 
-namespace dcm {
+#include "core/errors.hpp"  // IoError
 
-struct IoError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+namespace dcm {
 
 struct NodeField {
   std::string name;
@@ -35,6 +33,13 @@ class H5Output {
  public:
   // Creates (truncates) h5_path; the XDMF goes to the same path with extension ".xmf".
   explicit H5Output(const std::string& h5_path);
+  // Continues the file of an earlier run (a restart from a checkpoint): keeps its mesh and its first
+  // keep_frames frames, deletes later frames and the whole series (the caller appends the rows again).
+  // Throws IoError if the file is missing, has fewer frames, or was not written by H5Output.
+  struct Resume {
+    int keep_frames;
+  };
+  H5Output(const std::string& h5_path, Resume resume);
   ~H5Output();  // closes; never throws
   H5Output(const H5Output&) = delete;
   H5Output& operator=(const H5Output&) = delete;
@@ -48,6 +53,7 @@ class H5Output {
   void append_series(const std::vector<std::pair<std::string, double>>& row);
   void flush();
   void close();
+  int frames() const;  // frames in the file
 
   const std::string& h5_path() const { return h5_path_; }
   const std::string& xdmf_path() const { return xdmf_path_; }

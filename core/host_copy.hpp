@@ -1,6 +1,8 @@
 #pragma once
-// Copy a rank-1 or rank-2 View to the host as a flat row-major std::vector (reports, output, tests).
+// Copy a rank-1 or rank-2 View to the host as a flat row-major std::vector (reports, output, tests), and
+// back (checkpoints).
 #include <Kokkos_Core.hpp>
+#include <stdexcept>
 #include <vector>
 
 namespace dcm {
@@ -20,6 +22,18 @@ std::vector<typename View::non_const_value_type> to_host_vector(const View& v) {
         out.push_back(h(i));
     }
   return out;
+}
+
+// The inverse of to_host_vector(): fills v (rank 2) from a flat row-major vector of the same size.
+template <class View>
+void from_host_vector(const View& v, const std::vector<typename View::non_const_value_type>& values) {
+  static_assert(View::rank == 2, "rank 2");
+  auto h = Kokkos::create_mirror_view(v);
+  const std::size_t n0 = h.extent(0), n1 = h.extent(1);
+  if (values.size() != n0 * n1) throw std::invalid_argument("from_host_vector: size mismatch");
+  for (std::size_t i = 0; i < n0; ++i)
+    for (std::size_t j = 0; j < n1; ++j) h(i, j) = values[i * n1 + j];
+  Kokkos::deep_copy(v, h);
 }
 
 }  // namespace dcm

@@ -179,6 +179,9 @@ std::vector<ParamSpec> make_schema() {
                "simulated time between HDF5 frames (spread also writes t = 0.1, 0.35, 0.9 s and the end)"),
       int_key("output.series_per_decade", "40", 1, 10000,
               "rows of series.csv per decade of simulated time (log-spaced; every step for the first ten)"),
+      real_key("output.checkpoint_every_s", "600", 0, 1e7, kIncl, "s",
+               "wall-clock time between checkpoints (<out>/checkpoint.h5; also written at the end and on "
+               "Ctrl-C); 0: only those two. spread --restart continues from it"),
   };
 }
 

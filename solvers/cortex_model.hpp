@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "core/checkpoint.hpp"
 #include "core/errors.hpp"
 #include "core/host_copy.hpp"
 #include "core/update_geometry.hpp"
@@ -136,6 +137,18 @@ class CortexModel {
   void node_fields(const NodeFields<Mem>& out) const {
     if (!bonds_) throw std::logic_error("node_fields() needs the FENE+POW bond term");
     compute_node_fields(space_, mesh_, geo_, *bonds_, params_.bonds, force_, out);
+  }
+  // The state a step starts from: positions and the last velocity (the warm start of the next solve). The
+  // rest states, parameters and external forces are not saved: they come from the scene.
+  void save_state(Checkpoint& c) const {
+    c.put("model.x", to_host_vector(mesh_.x));
+    c.put("model.v", to_host_vector(velocity_));
+  }
+  void restore_state(const Checkpoint& c) {
+    const std::size_t size = 3 * static_cast<std::size_t>(mesh_.n_nodes);
+    from_host_vector(mesh_.x, c.array("model.x", size));
+    from_host_vector(velocity_, c.array("model.v", size));
+    update_geometry(space_, mesh_, geo_, params_.h_min);
   }
   // Largest d / d_max over the bonds at the current positions (0 without bonds).
   double max_bond_extension() const {

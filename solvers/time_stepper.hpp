@@ -9,7 +9,9 @@
 // again, shorter; otherwise the next step is h · min(2, max(0.2, 0.9 √(tol/e))), within [dt_min, dt_max].
 #include <cmath>
 
+#include "core/checkpoint.hpp"
 #include "core/errors.hpp"
+#include "core/host_copy.hpp"
 #include "solvers/cortex_model.hpp"
 
 namespace dcm {
@@ -45,6 +47,25 @@ class TimeStepper {
   double time() const { return t_; }
   double next_step() const { return h_next_; }
   const TimeStepSettings& settings() const { return settings_; }
+
+  // Everything the next step depends on, for a bit-identical restart (the settings come from the scene).
+  void save_state(Checkpoint& c) const {
+    c.put("stepper.t", t_);
+    c.put("stepper.h_next", h_next_);
+    c.put("stepper.h_prev", h_prev_);
+    c.put("stepper.has_prev", has_prev_ ? 1.0 : 0.0);
+    c.put("stepper.x_prev", to_host_vector(x_prev_));
+    c.put("stepper.v_prev", to_host_vector(v_prev_));
+  }
+  void restore_state(const Checkpoint& c) {
+    t_ = c.scalar("stepper.t");
+    h_next_ = c.scalar("stepper.h_next");
+    h_prev_ = c.scalar("stepper.h_prev");
+    has_prev_ = c.scalar("stepper.has_prev") != 0;
+    const std::size_t size = 3 * x_prev_.extent(0);
+    from_host_vector(x_prev_, c.array("stepper.x_prev", size));
+    from_host_vector(v_prev_, c.array("stepper.v_prev", size));
+  }
 
   // One step, at most h_cap long (the caller's t_end). observe(h) is called once, after the velocity of the
   // step is known and before the positions move (the caller samples energies there); h is the step about to

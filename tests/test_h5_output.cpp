@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -11,13 +12,18 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/checkpoint.hpp"
 #include "core/h5_output.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 using dcm::H5Output;
+using dcm::Checkpoint;
+using dcm::IoError;
 using dcm::NodeField;
+using dcm::read_checkpoint;
+using dcm::write_checkpoint;
 
 #ifndef DCM_SOURCE_DIR
 #define DCM_SOURCE_DIR "."
@@ -500,3 +506,84 @@ TEST_F(H5OutputTest, PythonCheckerAcceptsOutputAndRejectsBrokenXdmf) {
 }
 
 }  // namespace
+
+TEST_F(H5OutputTest, ResumeKeepsTheFirstFramesAndRestartsTheSeries) {
+  {
+    H5Output out(path("run.h5"));
+    write_run(out);  // 3 frames, 5 series rows
+  }
+  std::string xmf_before;
+  {
+    H5Output out(path("run.h5"), H5Output::Resume{2});
+    EXPECT_EQ(out.frames(), 2);
+    const FrameData f(7);
+    EXPECT_EQ(out.write_frame(f.time, f.x.data(), f.fields()), 2);
+    out.append_series(series_row(9));
+    out.close();
+  }
+  Handle file{H5Fopen(path("run.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  ASSERT_GE(file.id, 0);
+  EXPECT_EQ(read_time(file.id, "/frames/000001"), FrameData(1).time);
+  EXPECT_EQ(read_time(file.id, "/frames/000002"), FrameData(7).time);  // the new frame replaced the third
+  EXPECT_FALSE(exists(file.id, "/frames/000003"));
+  EXPECT_EQ(dims_of(file.id, "/series/time"), std::vector<hsize_t>{1});
+  EXPECT_EQ(read_text(file.id, "scene"), scene_text_);
+  if (system_python_has_h5py()) {
+    EXPECT_EQ(run_checker(path("run.xmf"), path("check.log")), 0);
+  }
+}
+
+TEST_F(H5OutputTest, ResumeOfAMissingOrForeignFileThrowsIoError) {
+  EXPECT_THROW(H5Output(path("none.h5"), H5Output::Resume{0}), IoError);
+  {
+    H5Output out(path("run.h5"));
+    write_run(out);
+  }
+  try {
+    H5Output(path("run.h5"), H5Output::Resume{4});
+    FAIL() << "a resume past the frames in the file must throw";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("3 frames"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(H5OutputTest, CheckpointRoundTripsBitForBitAndIsReplacedAtomically) {
+  Checkpoint c;
+  c.put("a.scalar", 1.0 / 3.0);
+  c.put("a.array", std::vector<double>{-0.0, 1e-300, 6.02e23, std::nextafter(1.0, 2.0)});
+  c.put("a.empty", std::vector<double>{});
+  c.put_text("scene", scene_text_);
+  c.put_text("csv", "t_s,r_cc_m\n0.1,2e-6\n");
+  write_checkpoint(path("cp.h5"), c);
+  c.put("a.scalar", 2.0);
+  write_checkpoint(path("cp.h5"), c);  // over the old one
+  EXPECT_FALSE(fs::exists(path("cp.h5.tmp")));
+  const Checkpoint r = read_checkpoint(path("cp.h5"));
+  EXPECT_EQ(r.scalar("a.scalar"), 2.0);
+  const std::vector<double>& a = r.array("a.array", 4);
+  EXPECT_TRUE(same_bits(a, c.arrays.at("a.array").data(), 4));
+  EXPECT_TRUE(std::signbit(a[0]));
+  EXPECT_TRUE(r.array("a.empty").empty());
+  EXPECT_EQ(r.text("scene"), scene_text_);
+  EXPECT_EQ(r.text("csv"), c.texts.at("csv"));
+  EXPECT_THROW(r.array("a.array", 5), IoError);  // a checkpoint of another mesh
+  EXPECT_THROW(r.scalar("missing"), IoError);
+}
+
+TEST_F(H5OutputTest, ReadingAnythingButACheckpointThrowsOneLineIoError) {
+  {
+    std::ofstream(path("text.h5")) << "not hdf5\n";
+    H5Output out(path("run.h5"));
+    write_run(out);
+  }
+  for (const std::string name : {"missing.h5", "text.h5", "run.h5"}) {
+    try {
+      read_checkpoint(path(name));
+      FAIL() << name;
+    } catch (const IoError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(name), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
+}
