@@ -245,14 +245,14 @@ bool in_range(const ParamSpec& spec, double v) {
 }
 
 std::string checked_int(const ParamSpec& spec, long long v, const std::string& origin) {
-  const std::string text = std::to_string(v);
+  std::string text = std::to_string(v);
   if (!is_choice(spec, text)) fail_not_a_choice(origin, spec, text);
   if (!in_range(spec, static_cast<double>(v))) fail_out_of_range(origin, spec, text);
   return text;
 }
 
 std::string checked_real(const ParamSpec& spec, double v, const std::string& origin) {
-  const std::string text = format_real(v);
+  std::string text = format_real(v);
   if (!in_range(spec, v)) fail_out_of_range(origin, spec, text);
   return text;
 }

@@ -122,8 +122,9 @@ std::vector<ParamSpec> make_schema() {
       int_choice_key("contact.quadrature_points", "0", {"0", "1", "3", "7", "16"},
                      "pressure integration over a triangle: 0 = exact in r (dcm's default), 1/3/7/16 = the "
                      "paper's point rules (eq. 18)"),
-      real_key("contact.start_gap_m", "10e-9", 0, 1e-6, kIncl, "m",
-               "spread: the cell's lowest node starts this far above the plane (below contact.h0_m)"),
+      real_key("contact.start_gap_m", "10e-9", -1e-6, 1e-5, kIncl, "m",
+               "spread: the cell's lowest node starts this far above the plane (below contact.h0_m, or "
+               "higher with gravity on; negative: pressed into the plane)"),
       real_key("contact.W_J_per_m2", "1e-3", 0, 1, kIncl, "J/m²", "work of adhesion"),
       real_key("contact.h0_m", "20e-9", 0, 1e-6, kExcl, "m", "range of adhesion (Dugdale)"),
       real_key("contact.gamma_n_N_s_per_m3", "8e9", 0, 1e15, kIncl, "N·s/m³", "normal substrate friction"),

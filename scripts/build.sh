@@ -6,12 +6,14 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 preset=${1:-release}
 shift || true
-kokkos=$(bash scripts/deps.sh | tail -n 1)
 case "$preset" in
-  release) builddir=build ;;
-  debug) builddir=build-debug ;;
-  *) echo "scripts/build.sh: unknown preset '$preset' (release, debug)" >&2; exit 2 ;;
+  release) builddir=build kokkos_variant=release ;;
+  debug) builddir=build-debug kokkos_variant=bounds-check ;;
+  sanitize) builddir=build-sanitize kokkos_variant=bounds-check ;;
+  *) echo "scripts/build.sh: unknown preset '$preset' (release, debug, sanitize)" >&2; exit 2 ;;
 esac
+# debug and sanitize use a Kokkos with bounds checking on every View access (unless Kokkos_ROOT is given).
+kokkos=$(DCM_KOKKOS_VARIANT=$kokkos_variant bash scripts/deps.sh | tail -n 1)
 # Configure when there is no build yet, or the preset, the Kokkos or CI-ness (warnings as errors) changed.
 stamp="$preset;$kokkos;ci=${CI:-false}"
 if [ ! -f "$builddir/CMakeCache.txt" ] || ! grep -qxF "DCM_CONFIGURED_FOR:STRING=$stamp" "$builddir/CMakeCache.txt"; then

@@ -35,14 +35,21 @@ if [ -n "$user_kokkos" ]; then
   exit 0
 fi
 
-prefix="$cache/kokkos-3.4.1-openmp"
+# DCM_KOKKOS_VARIANT=bounds-check (scripts/build.sh debug|sanitize): the same Kokkos with bounds checking
+# on every View access, in its own prefix.
+variant=${DCM_KOKKOS_VARIANT:-release}
+case "$variant" in
+  release) prefix="$cache/kokkos-3.4.1-openmp" variant_flags=() ;;
+  bounds-check) prefix="$cache/kokkos-3.4.1-openmp-boundscheck" variant_flags=(-DKokkos_ENABLE_DEBUG_BOUNDS_CHECK=ON) ;;
+  *) log "error: DCM_KOKKOS_VARIANT = '$variant' is not allowed: choose release or bounds-check"; exit 2 ;;
+esac
 if [ -f "$prefix/.dcm-complete" ]; then
-  log "Kokkos 3.4.1 (Serial+OpenMP): cached at $prefix"
+  log "Kokkos 3.4.1 (Serial+OpenMP, $variant): cached at $prefix"
   echo "$prefix"
   exit 0
 fi
 
-log "building Kokkos 3.4.1 (Serial+OpenMP) from Debian's trilinos source into $prefix"
+log "building Kokkos 3.4.1 (Serial+OpenMP, $variant) from Debian's trilinos source into $prefix"
 work=$(mktemp -d "${TMPDIR:-/tmp}/dcm-kokkos.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 # A private apt configuration that only knows a deb-src line: the system's apt set-up stays untouched.
@@ -56,10 +63,10 @@ tarball=$(ls "$work"/src/trilinos_*.orig.tar.* | head -n 1)
 tar -xf "$tarball" -C "$work/src" --wildcards '*/packages/kokkos/*'
 ksrc=$(ls -d "$work"/src/*/packages/kokkos | head -n 1)
 mkdir -p "$cache"
-buildlog="$cache/kokkos-3.4.1-build.log"
+buildlog="$cache/kokkos-3.4.1-$variant-build.log"
 if ! { cmake -S "$ksrc" -B "$work/build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX="$prefix" \
          -DKokkos_ENABLE_SERIAL=ON -DKokkos_ENABLE_OPENMP=ON -DCMAKE_CXX_STANDARD=17 \
-         -DCMAKE_POSITION_INDEPENDENT_CODE=ON -DBUILD_SHARED_LIBS=OFF &&
+         -DCMAKE_POSITION_INDEPENDENT_CODE=ON -DBUILD_SHARED_LIBS=OFF "${variant_flags[@]}" &&
        cmake --build "$work/build" --parallel "$(nproc)" &&
        cmake --install "$work/build"; } > "$buildlog" 2>&1; then
   tail -n 30 "$buildlog" >&2

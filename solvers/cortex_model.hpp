@@ -297,6 +297,28 @@ class CortexModel {
   // equals the dissipation vᵀΓv, with the implicit global terms it is vᵀ(Γ + dt K)v.
   double power() { return cg_detail::dot(space_, force_, velocity_); }
 
+  // The node with the largest total force (the first, if several); for messages.
+  int largest_force_node() const {
+    const auto f = force_;
+    double m = 0;
+    Kokkos::parallel_reduce(
+        "dcm::model::largest_force", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_nodes),
+        KOKKOS_LAMBDA(const int i, double& a) {
+          const double s = f(i, 0) * f(i, 0) + f(i, 1) * f(i, 1) + f(i, 2) * f(i, 2);
+          if (s > a) a = s;
+        },
+        Kokkos::Max<double>(m));
+    int first = mesh_.n_nodes;
+    Kokkos::parallel_reduce(
+        "dcm::model::largest_force_node", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_nodes),
+        KOKKOS_LAMBDA(const int i, int& a) {
+          const double s = f(i, 0) * f(i, 0) + f(i, 1) * f(i, 1) + f(i, 2) * f(i, 2);
+          if (s >= m && i < a) a = i;
+        },
+        Kokkos::Min<int>(first));
+    return first < mesh_.n_nodes ? first : 0;
+  }
+
   static std::string unconverged_message(const CgResult& r, const CgSettings& settings) {
     char msg[300];
     std::snprintf(

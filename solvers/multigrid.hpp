@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "core/buffers.hpp"
+#include "core/errors.hpp"
 #include "core/host_copy.hpp"
 #include "solvers/block_sparse.hpp"
 #include "solvers/friction_operator.hpp"
@@ -278,8 +279,10 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
       }
     }
     if (!mg_detail::invert_spd(dense, n))
-      throw std::runtime_error("multigrid: the coarsest operator of cell " + std::to_string(c) +
-                               " is not positive definite (non-finite or non-positive friction?)");
+      throw NumericalError(
+          "the velocity solve's operator (friction + dt x implicit stiffness) is not positive "
+          "definite on the coarsest multigrid level of cell " +
+          std::to_string(c) + " (a non-finite position or a negative coefficient)");
     for (int p = 0; p < n; ++p)
       for (int q = 0; q < n; ++q) mg.coarse_inverse_host(c, p, q) = dense[p * n + q];
   }

@@ -22,6 +22,9 @@ struct TimeStepSettings {
   double error_tol_m = 1e-9;            // m: allowed local position error per step (adaptive)
   double dt_min = 1e-9, dt_max = 1e-3;  // s: bounds of the adaptive step
   int max_halvings = 20;  // halvings for a bond near d_max before the run stops (NumericalError)
+  // Halvings for a velocity solve that does not converge: if h/64 does not help, the operator is not the
+  // problem a shorter step solves (indefinite or non-finite); the run stops instead of crawling.
+  int max_solve_halvings = 6;
 };
 
 struct StepReport {
@@ -29,7 +32,8 @@ struct StepReport {
   int iterations = 0;  // CG iterations of all solves in this step
   int halvings = 0;    // retries with h/2: a bond came too close to d_max, or the solve did not converge
   int rejections = 0;  // adaptive: times the previous step was taken again, shorter
-  double error_m = 0;  // adaptive: the error estimate of the previous step (m)
+  int unconverged_solves = 0;  // solves that reached the CG iteration cap (each retried with h/2)
+  double error_m = 0;          // adaptive: the error estimate of the previous step (m)
 };
 
 template <class ExecutionSpace>
@@ -134,11 +138,13 @@ class TimeStepper {
       const CgResult r = model.solve_velocity(cg, h, false);
       rep.iterations += r.iterations;
       if (r.converged) return;
-      if (rep.halvings >= settings_.max_halvings)
+      if (rep.halvings >= settings_.max_halvings || rep.unconverged_solves >= settings_.max_solve_halvings)
         throw NumericalError(Model::unconverged_message(r, cg) + ", even with the time step halved " +
-                             std::to_string(rep.halvings) + " times");
+                             std::to_string(rep.halvings) + " times; largest force at node " +
+                             std::to_string(model.largest_force_node()));
       h *= 0.5;
       ++rep.halvings;
+      ++rep.unconverged_solves;
     }
   }
   double grow(double h, double err) const {

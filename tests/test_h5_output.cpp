@@ -18,8 +18,8 @@
 namespace {
 
 namespace fs = std::filesystem;
-using dcm::H5Output;
 using dcm::Checkpoint;
+using dcm::H5Output;
 using dcm::IoError;
 using dcm::NodeField;
 using dcm::read_checkpoint;

@@ -147,10 +147,35 @@ void run(const AppOptions& options, const SpreadOptions& so) {
     throw SceneError("--early-window-s = " + std::to_string(so.early_from_s) + "," +
                      std::to_string(so.early_to_s) + " is not allowed: need 0 < from < to");
   const double h0 = scene.get_real("contact.h0_m"), gap = scene.get_real("contact.start_gap_m");
-  if (!(gap < h0))
-    throw SceneError("contact.start_gap_m = " + std::to_string(gap) +
-                     " is not allowed: it must be below contact.h0_m = " + std::to_string(h0) +
-                     " (the cell starts within the range of adhesion)");
+  const bool falls =
+      scene.get_real("body.gravity_m_per_s2") > 0 && scene.get_real("body.density_excess_kg_per_m3") > 0;
+  if (!(gap < h0) && !falls)
+    throw SceneError("contact.start_gap_m = " + detail::format_real(gap) +
+                     " is not allowed: it must be below contact.h0_m = " + detail::format_real(h0) +
+                     " (the cell starts within the range of adhesion), unless gravity brings the cell down "
+                     "(body.gravity_m_per_s2 > 0 with body.density_excess_kg_per_m3 > 0)");
+  if (!(gap < h0)) {
+    // The cell has to sink to the plane. Its weight is spread over the nodes, so the force vector's norm is
+    // Δρ V g / √N: the CG's absolute tolerance must lie well below it, or the solve returns v = 0 and the
+    // cell hangs in the fluid (the paper's 1e-14 N is larger than a 642-node RBC's weight norm, 4e-15 N).
+    const double r = scene.get_string("mesh.shape") == "sphere" ? scene.get_real("mesh.radius_m")
+                                                                : scene.get_real("mesh.diameter_m") / 2;
+    const double weight = scene.get_real("body.density_excess_kg_per_m3") * 4.0 / 3.0 * kPi * r * r * r *
+                          scene.get_real("body.gravity_m_per_s2");
+    const double norm = weight / std::sqrt(static_cast<double>(scene.get_int("mesh.nodes")));
+    const auto g3 = [](double v) {
+      char b[32];
+      std::snprintf(b, sizeof b, "%.3g", v);
+      return std::string(b);
+    };
+    if (scene.get_real("solver.cg_abs_tol_N") > 1e-3 * norm)
+      throw SceneError(
+          "solver.cg_abs_tol_N = " + detail::format_real(scene.get_real("solver.cg_abs_tol_N")) +
+          " is too large for a cell that sinks to the plane (contact.start_gap_m >= contact.h0_m): "
+          "its weight per node, " +
+          detail::format_real(norm) + " N in norm, needs a tolerance <= " + detail::format_real(1e-3 * norm) +
+          " N");
+  }
   const double dt = scene.get_real("time.dt_s"), t_end = scene.get_real("time.t_end_s");
   const TimeStepSettings step_settings = steps_from_scene(scene);
   const std::string out = restart
@@ -273,6 +298,16 @@ void run(const AppOptions& options, const SpreadOptions& so) {
     write_checkpoint(checkpoint_path, c);
   };
   auto last_checkpoint = std::chrono::steady_clock::now();
+  // Numerical trouble ends the run (exit 3) with the files closed: what was done stays readable, no NaN row.
+  auto stop_on_numerical_trouble = [&](const std::string& what) {
+    h5.close();
+    csv.close();
+    std::rename(csv_tmp.c_str(), (out_dir + "/series.csv").c_str());
+    throw NumericalError(what + " — try a smaller time.dt_s or time.adaptive = true" +
+                         (std::filesystem::exists(checkpoint_path)
+                              ? "; the last checkpoint is " + checkpoint_path
+                              : std::string()));
+  };
 
   // Forward Euler at the scene's fixed Δt (the paper's) or with adaptive, error-controlled steps; a step
   // that would take a bond too close to d_max is taken again with half the step (solvers/time_stepper.hpp).
@@ -309,14 +344,8 @@ void run(const AppOptions& options, const SpreadOptions& so) {
         }
       });
     } catch (const NumericalError& e) {
-      h5.close();  // what was done stays readable
-      csv.close();
-      std::rename(csv_tmp.c_str(), (out_dir + "/series.csv").c_str());
-      throw NumericalError("step " + std::to_string(index) + " (t = " + std::to_string(stepper.time()) +
-                           " s): " + e.what() + " — try a smaller time.dt_s" +
-                           (std::filesystem::exists(checkpoint_path)
-                                ? "; the last checkpoint is " + checkpoint_path
-                                : std::string()));
+      stop_on_numerical_trouble("step " + std::to_string(index) + " (t = " + std::to_string(stepper.time()) +
+                                " s): " + e.what());
     }
     p.step += 1;
     const double h = rep.h;
@@ -332,7 +361,15 @@ void run(const AppOptions& options, const SpreadOptions& so) {
       const double e1 = model.energy(), de = (e1 - e0) / h, residual = de - (pc - dis);
       p.worst_residual = std::max(p.worst_residual, std::fabs(residual));
       p.worst_residual_scale = std::max(p.worst_residual_scale, std::fabs(dis) + std::fabs(pc));
-      const double area_c = model.contact_area(), r_cc = std::sqrt(area_c / kPi);
+      const double area_c = model.contact_area();
+      if (!(area_c >= 0)) {  // an inverted triangle in the contact: the state is no longer a cell
+        const auto tri_area_c = to_host_vector(model.contact()->tri_contact_area);
+        const auto worst = std::min_element(tri_area_c.begin(), tri_area_c.end()) - tri_area_c.begin();
+        stop_on_numerical_trouble("step " + std::to_string(index) + " (t = " + std::to_string(t + h) +
+                                  " s): the contact area is " + detail::format_real(area_c) +
+                                  " m² (triangle " + std::to_string(worst) + " of the contact is inverted)");
+      }
+      const double r_cc = std::sqrt(area_c / kPi);
       const auto xh = to_host_vector(model.positions());
       double ztop = -INFINITY;
       for (int i = 0; i < n; ++i) ztop = std::max(ztop, xh[3 * i + 2]);
