@@ -196,7 +196,8 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
           beta(t, k) = nl.beta[k];
         }
         load(t) = Fn;
-        contact_area(t) = a_contact;
+        contact_area(t) =
+            math::max(a_contact, 0.0);  // the exact integral of an empty overlap can round to -1e-28
         friction_area(t) = prm.friction_on_adhesive_zone ? a_zone : a_contact;
         const double projected = 0.5 * math::fabs(dot(cross(x1 - x0, x2 - x0), n));
         if (a_contact >= (1 - 1e-9) * projected && projected > 0) regime(t) = kFullContact;

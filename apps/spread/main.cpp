@@ -362,12 +362,13 @@ void run(const AppOptions& options, const SpreadOptions& so) {
       p.worst_residual = std::max(p.worst_residual, std::fabs(residual));
       p.worst_residual_scale = std::max(p.worst_residual_scale, std::fabs(dis) + std::fabs(pc));
       const double area_c = model.contact_area();
-      if (!(area_c >= 0)) {  // an inverted triangle in the contact: the state is no longer a cell
+      if (!(area_c >= 0)) {  // not finite: the state is no longer a cell
         const auto tri_area_c = to_host_vector(model.contact()->tri_contact_area);
-        const auto worst = std::min_element(tri_area_c.begin(), tri_area_c.end()) - tri_area_c.begin();
+        const auto bad =
+            std::find_if(tri_area_c.begin(), tri_area_c.end(), [](double a) { return !(a >= 0); });
         stop_on_numerical_trouble("step " + std::to_string(index) + " (t = " + std::to_string(t + h) +
                                   " s): the contact area is " + detail::format_real(area_c) +
-                                  " m² (triangle " + std::to_string(worst) + " of the contact is inverted)");
+                                  " m² (first at triangle " + std::to_string(bad - tri_area_c.begin()) + ")");
       }
       const double r_cc = std::sqrt(area_c / kPi);
       const auto xh = to_host_vector(model.positions());

@@ -85,7 +85,7 @@ def run_case(a, out, sets, extra):
         lines = err.splitlines()
         if len(lines) != 1:
             problems.append(f"{len(lines)} lines on stderr")
-        if "step" not in err or not any(w in err for w in ("node", "bond", "cell")):
+        if "step" not in err or not any(w in err for w in ("node", "bond", "cell", "triangle")):
             problems.append("the message does not name the step and the node, bond or cell")
         if "try" not in err:
             problems.append("the message suggests no remedy")
