@@ -316,8 +316,9 @@ TEST(PlaneContactEdges, FlatTrianglesExactlyTangentToThePlaneOrAtH0GiveFiniteLoa
       prm.quadrature_points = nq;
       const MeshContact c = contact_of(flattened_sphere(z), prm);
       expect_finite_and_consistent(c, "flat bottom at z = " + std::to_string(z) + ", q" + std::to_string(nq));
-      if (z <= 0 && nq == 0)
+      if (z <= 0 && nq == 0) {
         EXPECT_GT(c.load_sum, 0) << "pressed flat face must be pushed back (z = " << z << ")";
+      }
       // (Above the plane the sign depends on the rim triangles, whose rounded caps bulge past the flat
       // face by more than the gap; no sign is asserted there.)
     }
