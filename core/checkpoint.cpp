@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "core/h5_links.hpp"
+
 namespace dcm {
 namespace {
 
@@ -51,18 +53,6 @@ bool read_string(hid_t obj, bool attribute, std::string& out) {
   out = ptr;
   H5free_memory(ptr);
   return true;
-}
-
-std::vector<std::string> member_names(hid_t group) {
-  std::vector<std::string> names;
-  H5Literate(
-      group, H5_INDEX_NAME, H5_ITER_INC, nullptr,
-      [](hid_t, const char* name, const H5L_info_t*, void* data) -> herr_t {
-        static_cast<std::vector<std::string>*>(data)->emplace_back(name);
-        return 0;
-      },
-      &names);
-  return names;
 }
 
 bool is_hdf5(const std::string& path) {
@@ -141,7 +131,7 @@ Checkpoint read_checkpoint(const std::string& path) {
   Handle arrays(H5Gopen2(file.id, "arrays", H5P_DEFAULT), H5Gclose);
   Handle texts(H5Gopen2(file.id, "texts", H5P_DEFAULT), H5Gclose);
   if (arrays.id < 0 || texts.id < 0) throw not_a_checkpoint();
-  for (const std::string& name : member_names(arrays.id)) {
+  for (const std::string& name : detail::h5_link_names(arrays.id)) {
     Handle d(H5Dopen2(arrays.id, name.c_str(), H5P_DEFAULT), H5Dclose);
     Handle space(H5Dget_space(d.id), H5Sclose);
     if (d.id < 0 || space.id < 0 || H5Sget_simple_extent_ndims(space.id) != 1) throw not_a_checkpoint();
@@ -152,7 +142,7 @@ Checkpoint read_checkpoint(const std::string& path) {
       throw IoError(path + ": cannot read '" + name + "'");
     c.arrays[name] = std::move(values);
   }
-  for (const std::string& name : member_names(texts.id)) {
+  for (const std::string& name : detail::h5_link_names(texts.id)) {
     Handle d(H5Dopen2(texts.id, name.c_str(), H5P_DEFAULT), H5Dclose);
     std::string text;
     if (d.id < 0 || !read_string(d.id, false, text)) throw IoError(path + ": cannot read '" + name + "'");

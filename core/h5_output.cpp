@@ -8,6 +8,8 @@
 #include <iostream>
 #include <memory>
 
+#include "core/h5_links.hpp"
+
 #ifndef DCM_VERSION
 #define DCM_VERSION "0.1.0"
 #endif
@@ -304,18 +306,6 @@ H5Output::H5Output(const std::string& h5_path) : impl_(nullptr), h5_path_(h5_pat
 
 namespace {
 
-std::vector<std::string> link_names(hid_t group) {
-  std::vector<std::string> names;
-  H5Literate(
-      group, H5_INDEX_NAME, H5_ITER_INC, nullptr,
-      [](hid_t, const char* name, const H5L_info_t*, void* data) -> herr_t {
-        static_cast<std::vector<std::string>*>(data)->emplace_back(name);
-        return 0;
-      },
-      &names);
-  return names;
-}
-
 // Dimensions of a dataset (empty if it cannot be read).
 std::vector<hsize_t> dataset_dims(hid_t loc, const std::string& name) {
   const hid_t set = H5Dopen2(loc, name.c_str(), H5P_DEFAULT);
@@ -354,7 +344,7 @@ H5Output::H5Output(const std::string& h5_path, Resume resume) : impl_(nullptr), 
   m.n_tris = static_cast<int>(tris[0]);
   m.has_mesh = true;
   Hid frames = m.make(H5Gopen2(id, "/frames", H5P_DEFAULT), H5Gclose, "cannot open /frames");
-  const std::vector<std::string> names = link_names(frames.get());
+  const std::vector<std::string> names = detail::h5_link_names(frames.get());
   if (static_cast<int>(names.size()) < resume.keep_frames)
     m.fail("cannot continue: it holds " + std::to_string(names.size()) + " frames, the checkpoint " +
            std::to_string(resume.keep_frames));
@@ -371,7 +361,7 @@ H5Output::H5Output(const std::string& h5_path, Resume resume) : impl_(nullptr), 
       m.checked(H5Aread(attr.get(), H5T_NATIVE_DOUBLE, &time), "cannot read the time of " + group_name);
     }
     std::string attributes;
-    for (const std::string& field : link_names(group.get())) {
+    for (const std::string& field : detail::h5_link_names(group.get())) {
       if (field == "x") continue;
       const std::vector<hsize_t> dims = dataset_dims(group.get(), field);
       const int components = dims.size() == 2 ? static_cast<int>(dims[1]) : 1;
