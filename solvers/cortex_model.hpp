@@ -250,9 +250,15 @@ class CortexModel {
       update_tension_stiffness(space_, mesh_, geo_, *area_, params_.k_area_local, params_.k_area_global, dt,
                                *tension_stiffness_);
     // The multigrid's fine level holds Γ, the implicit bonds and the implicit tension (same sparsity).
-    if (multigrid_)
-      update_multigrid(space_, mesh_, friction_, *multigrid_,
-                       implicit_tension ? &*tension_stiffness_ : nullptr);
+    if (multigrid_) {
+      try {
+        update_multigrid(space_, mesh_, friction_, *multigrid_,
+                         implicit_tension ? &*tension_stiffness_ : nullptr);
+      } catch (const NumericalError& e) {  // the coarse level knows the cell; the force shows where it starts
+        throw NumericalError(std::string(e.what()) + "; the largest force is at node " +
+                             std::to_string(largest_force_node()));
+      }
+    }
     const bool implicit = dt > 0 && global_.has_value();
     const bool implicit_bending = dt > 0 && bending_stiffness_.has_value();
     if (implicit_bending)

@@ -29,6 +29,30 @@ MdMaterial material_for_lambda(double lambda) {
   return m;
 }
 
+// Contact of an arbitrary mesh with the plane z = 0: every per-triangle and per-node output, for the edge
+// cases below.
+struct MeshContact {
+  std::vector<double> load, area, node_force;
+  double load_sum = 0, node_load_sum = 0;
+};
+MeshContact contact_of(const HostMesh& m, const PlaneContactParams& prm) {
+  const Exec space;
+  const MeshBuffers<Mem> mesh = upload_cells<Mem>({HostCell(m)});
+  const GeometryBuffers<Mem> geo(mesh);
+  update_geometry(space, mesh, geo, 1e4);
+  ContactBuffers<Mem> contact(mesh.n_tris);
+  compute_plane_contact(space, mesh, geo, Plane{}, prm, contact);
+  Kokkos::View<double* [3], Kokkos::LayoutRight, Mem> force("force", mesh.n_nodes);
+  add_plane_contact_forces(space, mesh, Plane{}, contact, force);
+  MeshContact r;
+  r.load = to_host_vector(contact.tri_load);
+  r.area = to_host_vector(contact.tri_contact_area);
+  r.node_force = to_host_vector(force);
+  for (double l : r.load) r.load_sum += l;
+  for (std::size_t i = 2; i < r.node_force.size(); i += 3) r.node_load_sum += r.node_force[i];
+  return r;
+}
+
 struct SphereContact {
   double load = 0, node_load = 0, area = 0, edge = 0;
 };
@@ -44,29 +68,20 @@ SphereContact sphere_at_overlap(int k, double delta, const PlaneContactParams& p
     x[2] = z;
   }
   for (auto& x : m.nodes) x[2] += kR - delta;
-  const Exec space;
-  const MeshBuffers<Mem> mesh = upload_cells<Mem>({HostCell(m)});
-  const GeometryBuffers<Mem> geo(mesh);
-  update_geometry(space, mesh, geo, 1e4);
-  ContactBuffers<Mem> contact(mesh.n_tris);
-  compute_plane_contact(space, mesh, geo, Plane{}, prm, contact);
-  Kokkos::View<double* [3], Kokkos::LayoutRight, Mem> force("force", mesh.n_nodes);
-  add_plane_contact_forces(space, mesh, Plane{}, contact, force);
+  const MeshContact c = contact_of(m, prm);
   SphereContact r;
-  r.load = total_contact_load(space, contact);
-  r.area = total_contact_area(space, contact);
-  const auto f = to_host_vector(force);
-  for (std::size_t i = 2; i < f.size(); i += 3) r.node_load += f[i];
-  const auto tri = to_host_vector(mesh.tri);
+  r.load = c.load_sum;
+  r.node_load = c.node_load_sum;
+  for (double area : c.area) r.area += area;
   double sum = 0;
-  for (std::size_t t = 0; t < tri.size(); t += 3)
+  for (const Tri& t : m.triangles)
     for (int e = 0; e < 3; ++e) {
-      const auto& p = m.nodes[tri[t + e]];
-      const auto& q = m.nodes[tri[t + (e + 1) % 3]];
+      const auto& p = m.nodes[t[e]];
+      const auto& q = m.nodes[t[(e + 1) % 3]];
       sum += std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
                        (p[2] - q[2]) * (p[2] - q[2]));
     }
-  r.edge = sum / static_cast<double>(tri.size());
+  r.edge = sum / static_cast<double>(3 * m.triangles.size());
   return r;
 }
 
@@ -267,30 +282,6 @@ TEST(PlaneContact, LoadIsContinuousThroughOnsetAndTheEndOfTheGapBranch) {
       EXPECT_LT(worst, 0.01 * scale);
     }
   }
-}
-
-// Contact of an arbitrary mesh with the plane z = 0: every per-triangle and per-node output, for the edge
-// cases below.
-struct MeshContact {
-  std::vector<double> load, area, node_force;
-  double load_sum = 0, node_load_sum = 0;
-};
-MeshContact contact_of(const HostMesh& m, const PlaneContactParams& prm) {
-  const Exec space;
-  const MeshBuffers<Mem> mesh = upload_cells<Mem>({HostCell(m)});
-  const GeometryBuffers<Mem> geo(mesh);
-  update_geometry(space, mesh, geo, 1e4);
-  ContactBuffers<Mem> contact(mesh.n_tris);
-  compute_plane_contact(space, mesh, geo, Plane{}, prm, contact);
-  Kokkos::View<double* [3], Kokkos::LayoutRight, Mem> force("force", mesh.n_nodes);
-  add_plane_contact_forces(space, mesh, Plane{}, contact, force);
-  MeshContact r;
-  r.load = to_host_vector(contact.tri_load);
-  r.area = to_host_vector(contact.tri_contact_area);
-  r.node_force = to_host_vector(force);
-  for (double l : r.load) r.load_sum += l;
-  for (std::size_t i = 2; i < r.node_force.size(); i += 3) r.node_load_sum += r.node_force[i];
-  return r;
 }
 
 void expect_finite_and_consistent(const MeshContact& c, const std::string& what) {
