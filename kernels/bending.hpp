@@ -9,8 +9,12 @@
 // 0 for a flat hinge, > 0 where the surface is convex (a sphere: every theta > 0), < 0 where concave.
 // Energy and moment (eq. 26):
 //   U = k_b (1 - cos(theta - theta*)),   M = dU/dtheta = k_b sin(theta - theta*),
-// theta* the hinge's angle in the rest shape, k_b in J. Forces F_a = -M dtheta/dx_a, with the exact
-// gradient of theta (Bridson, Marino, Fedkiw 2003):
+// theta* the hinge's angle in the rest shape, k_b in J. The kernels never form theta itself: with
+//   cos theta = n1 . n2 / (|n1| |n2|),   sin theta = (n1 x n2) . e / (|e| |n1| |n2|)
+// (one square root for both) and the rest state kept as (cos theta*, sin theta*),
+//   sin(theta - theta*) = sin theta cos theta* - cos theta sin theta*,  cos(theta - theta*) likewise,
+// so a hinge costs two square roots and no atan2 or sin (docs/PERFORMANCE.md, "Force terms"). Forces F_a = -M
+// dtheta/dx_a, with the exact gradient of theta (Bridson, Marino, Fedkiw 2003):
 //   dtheta/dx_k = -|e| n1 / |n1|^2,        dtheta/dx_l = -|e| n2 / |n2|^2,
 //   dtheta/dx_i = -(1 - a_k) dtheta/dx_k - (1 - a_l) dtheta/dx_l,
 //   dtheta/dx_j = -a_k dtheta/dx_k - a_l dtheta/dx_l,
@@ -26,6 +30,9 @@
 // Expectations (tests/test_bonds_bending.cpp): F = -grad U (central differences), F = 0 at the rest
 // shape, zero net force and torque, theta = arccos(-1/3) on a regular tetrahedron, U = k_b (1 - cos dtheta)
 // for a hinge bent by dtheta, theta > 0 on a sphere, the same result on Serial and OpenMP.
+#include <cmath>
+#include <vector>
+
 #include "core/buffers.hpp"
 #include "core/vec3.hpp"
 
@@ -34,7 +41,7 @@ namespace dcm {
 // Rest state of the hinges and the scratch space of the hinge pass (allocated once).
 template <class MemorySpace>
 struct HingeRest {
-  Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> theta_rest;          // theta* (rad)
+  Kokkos::View<double* [2], Kokkos::LayoutRight, MemorySpace> rest_trig;       // (cos theta*, sin theta*)
   Kokkos::View<double* [4][3], Kokkos::LayoutRight, MemorySpace> hinge_force;  // scratch (N)
 };
 
@@ -45,19 +52,23 @@ KOKKOS_INLINE_FUNCTION double hinge_angle(Real3 xi, Real3 xj, Real3 xk, Real3 xl
   return math::atan2(dot(cross(n1, n2), e), norm(e) * dot(n1, n2));
 }
 
-// theta and its gradient with respect to (x_i, x_j, x_k, x_l); false (and a zero gradient) for a
-// degenerate hinge.
-KOKKOS_INLINE_FUNCTION bool hinge_angle_gradient(Real3 xi, Real3 xj, Real3 xk, Real3 xl, double& theta,
-                                                 Real3 grad[4]) {
+// cos theta, sin theta and the gradient of theta with respect to (x_i, x_j, x_k, x_l); false (theta = 0
+// and a zero gradient) for a degenerate hinge.
+KOKKOS_INLINE_FUNCTION bool hinge_trig_gradient(Real3 xi, Real3 xj, Real3 xk, Real3 xl, double& cos_theta,
+                                                double& sin_theta, Real3 grad[4]) {
   const Real3 e = xj - xi;
   const Real3 n1 = cross(e, xk - xi), n2 = cross(-e, xl - xj);
   const double e2 = norm2(e), n1_2 = norm2(n1), n2_2 = norm2(n2);
-  const double e_len = math::sqrt(e2);
-  theta = math::atan2(dot(cross(n1, n2), e), e_len * dot(n1, n2));
   if (!(e2 > 0 && n1_2 > 0 && n2_2 > 0)) {
+    cos_theta = 1;
+    sin_theta = 0;
     for (int a = 0; a < 4; ++a) grad[a] = Real3{0, 0, 0};
     return false;
   }
+  const double e_len = math::sqrt(e2);
+  const double inv = 1.0 / (e_len * math::sqrt(n1_2 * n2_2));  // 1 / (|e| |n1| |n2|)
+  cos_theta = e_len * dot(n1, n2) * inv;
+  sin_theta = dot(cross(n1, n2), e) * inv;
   const Real3 gk = (-e_len / n1_2) * n1, gl = (-e_len / n2_2) * n2;
   const double ak = dot(xk - xi, e) / e2, al = dot(xl - xi, e) / e2;
   grad[0] = (ak - 1) * gk + (al - 1) * gl;
@@ -68,11 +79,11 @@ KOKKOS_INLINE_FUNCTION bool hinge_angle_gradient(Real3 xi, Real3 xj, Real3 xk, R
 }
 
 // Forces of one hinge on (i, j, k, l) (N): F_a = -k_b sin(theta - theta*) dtheta/dx_a.
-KOKKOS_INLINE_FUNCTION void hinge_bending_forces(Real3 xi, Real3 xj, Real3 xk, Real3 xl, double theta_rest,
-                                                 double k_b, Real3 f[4]) {
-  double theta;
-  hinge_angle_gradient(xi, xj, xk, xl, theta, f);
-  const double m = -k_b * math::sin(theta - theta_rest);  // -M, eq. 26
+KOKKOS_INLINE_FUNCTION void hinge_bending_forces(Real3 xi, Real3 xj, Real3 xk, Real3 xl, double cos_rest,
+                                                 double sin_rest, double k_b, Real3 f[4]) {
+  double c, s;
+  hinge_trig_gradient(xi, xj, xk, xl, c, s, f);
+  const double m = -k_b * (s * cos_rest - c * sin_rest);  // -M = -k_b sin(theta - theta*), eq. 26
   for (int a = 0; a < 4; ++a) f[a] = m * f[a];
 }
 
@@ -80,20 +91,45 @@ KOKKOS_INLINE_FUNCTION void hinge_bending_forces(Real3 xi, Real3 xj, Real3 xk, R
 template <class ExecutionSpace, class MemorySpace>
 HingeRest<MemorySpace> make_hinge_rest(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh) {
   HingeRest<MemorySpace> rest;
-  rest.theta_rest = decltype(rest.theta_rest)(
-      Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::bending::theta_rest"), mesh.n_hinges);
+  rest.rest_trig = decltype(rest.rest_trig)(
+      Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::bending::rest_trig"), mesh.n_hinges);
   rest.hinge_force = decltype(rest.hinge_force)(
       Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::bending::hinge_force"), mesh.n_hinges);
   const auto x = mesh.x;
   const auto hinge = mesh.hinge;
-  const auto theta_rest = rest.theta_rest;
+  const auto rest_trig = rest.rest_trig;
   Kokkos::parallel_for(
-      "dcm::bending::theta_rest", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_hinges),
+      "dcm::bending::rest", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_hinges),
       KOKKOS_LAMBDA(const int h) {
-        theta_rest(h) = hinge_angle(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
-                                    load3(x, hinge(h, 3)));
+        double c, s;
+        Real3 grad[4];
+        hinge_trig_gradient(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
+                            load3(x, hinge(h, 3)), c, s, grad);
+        rest_trig(h, 0) = c;
+        rest_trig(h, 1) = s;
       });
   return rest;
+}
+
+// theta* of every hinge (rad, host copy; for tests and diagnostics).
+template <class MemorySpace>
+std::vector<double> hinge_rest_angles(const HingeRest<MemorySpace>& rest) {
+  const auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), rest.rest_trig);
+  std::vector<double> theta(h.extent(0));
+  for (std::size_t k = 0; k < theta.size(); ++k) theta[k] = std::atan2(h(k, 1), h(k, 0));
+  return theta;
+}
+
+// Sets theta* of every hinge (rad; one value for all, or one per hinge).
+template <class MemorySpace>
+void set_hinge_rest_angles(const HingeRest<MemorySpace>& rest, const std::vector<double>& theta) {
+  const auto h = Kokkos::create_mirror_view(rest.rest_trig);
+  for (std::size_t k = 0; k < h.extent(0); ++k) {
+    const double t = theta.size() == 1 ? theta[0] : theta.at(k);
+    h(k, 0) = std::cos(t);
+    h(k, 1) = std::sin(t);
+  }
+  Kokkos::deep_copy(rest.rest_trig, h);
 }
 
 // force(i) += bending forces on node i: one pass over the hinges into rest.hinge_force, then a gather
@@ -104,14 +140,14 @@ void add_bending_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpa
                         const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& force) {
   const auto x = mesh.x;
   const auto hinge = mesh.hinge;
-  const auto theta_rest = rest.theta_rest;
+  const auto rest_trig = rest.rest_trig;
   const auto hinge_force = rest.hinge_force;
   Kokkos::parallel_for(
       "dcm::bending::hinges", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_hinges),
       KOKKOS_LAMBDA(const int h) {
         Real3 f[4];
         hinge_bending_forces(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
-                             load3(x, hinge(h, 3)), theta_rest(h), k_b, f);
+                             load3(x, hinge(h, 3)), rest_trig(h, 0), rest_trig(h, 1), k_b, f);
         for (int a = 0; a < 4; ++a) {
           hinge_force(h, a, 0) = f[a].x;
           hinge_force(h, a, 1) = f[a].y;
@@ -143,7 +179,7 @@ void add_bending_forces_per_node(const ExecutionSpace& space, const MeshBuffers<
                                  const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& force) {
   const auto x = mesh.x;
   const auto hinge = mesh.hinge;
-  const auto theta_rest = rest.theta_rest;
+  const auto rest_trig = rest.rest_trig;
   const auto offsets = mesh.node_hinge_offsets;
   const auto roles = mesh.node_hinge_roles;
   Kokkos::parallel_for(
@@ -154,7 +190,7 @@ void add_bending_forces_per_node(const ExecutionSpace& space, const MeshBuffers<
           const int h = roles(s) / 4, a = roles(s) % 4;
           Real3 f[4];
           hinge_bending_forces(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
-                               load3(x, hinge(h, 3)), theta_rest(h), k_b, f);
+                               load3(x, hinge(h, 3)), rest_trig(h, 0), rest_trig(h, 1), k_b, f);
           sum += f[a];
         }
         force(i, 0) += sum.x;
@@ -169,14 +205,16 @@ double bending_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace
                       const HingeRest<MemorySpace>& rest, double k_b) {
   const auto x = mesh.x;
   const auto hinge = mesh.hinge;
-  const auto theta_rest = rest.theta_rest;
+  const auto rest_trig = rest.rest_trig;
   double energy = 0;
   Kokkos::parallel_reduce(
       "dcm::bending::energy", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_hinges),
       KOKKOS_LAMBDA(const int h, double& sum) {
-        const double theta = hinge_angle(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
-                                         load3(x, hinge(h, 3)));
-        sum += k_b * (1 - math::cos(theta - theta_rest(h)));
+        double c, s;
+        Real3 grad[4];
+        hinge_trig_gradient(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
+                            load3(x, hinge(h, 3)), c, s, grad);
+        sum += k_b * (1 - (c * rest_trig(h, 0) + s * rest_trig(h, 1)));  // 1 - cos(theta - theta*)
       },
       energy);
   return energy;

@@ -32,7 +32,7 @@ struct Fixture {
       for (int c = 0; c < 3; ++c) h(i, c) = stretched.nodes[i][c];
     Kokkos::deep_copy(mesh.x, h);
     // Bending against a flatter rest shape, so that sin(theta - theta*) != 0 everywhere.
-    Kokkos::deep_copy(hinges.theta_rest, 0.0);
+    set_hinge_rest_angles(hinges, {0.0});
     Kokkos::deep_copy(overstretched, -1);
     Exec().fence();
   }

@@ -25,16 +25,17 @@ void update_bending_stiffness(const ExecutionSpace& space, const MeshBuffers<Mem
                               const BendingStiffness<MemorySpace>& bs) {
   const auto x = mesh.x;
   const auto hinge = mesh.hinge;
-  const auto theta_rest = rest.theta_rest;
+  const auto rest_trig = rest.rest_trig;
   const auto g = bs.g;
   Kokkos::parallel_for(
       "dcm::bending_stiffness::update", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_hinges),
       KOKKOS_LAMBDA(const int h) {
-        double theta;
+        double c, s;
         Real3 grad[4];
-        hinge_angle_gradient(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
-                             load3(x, hinge(h, 3)), theta, grad);
-        const double w = math::sqrt(dt * k_b * math::max(math::cos(theta - theta_rest(h)), 0.0));
+        hinge_trig_gradient(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
+                            load3(x, hinge(h, 3)), c, s, grad);
+        const double cos_d = c * rest_trig(h, 0) + s * rest_trig(h, 1);  // cos(theta - theta*)
+        const double w = math::sqrt(dt * k_b * math::max(cos_d, 0.0));
         for (int a = 0; a < 4; ++a) {
           g(h, a, 0) = w * grad[a].x;
           g(h, a, 1) = w * grad[a].y;

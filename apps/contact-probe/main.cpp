@@ -1,0 +1,110 @@
+// contact-probe: the contact of every triangle of a spread checkpoint with the plane, as CSV on stdout: where
+// the triangle is, its rounded sphere (radius, overlap with the plane), its regime, its load and how eq. 19
+// shares the load among its three nodes. For asking why a cell spreads or stops (docs/VALIDATION.md,
+// "Where the contact line is held"). The scene is the checkpoint's; --set changes contact or geometry keys
+// to see what they would do to the same shape.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "apps/common/mechanics_setup.hpp"
+#include "core/checkpoint.hpp"
+#include "core/errors.hpp"
+#include "core/scene.hpp"
+
+namespace {
+
+using Exec = Kokkos::DefaultExecutionSpace;
+
+template <class V>
+auto host(const V& v) {
+  return Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), v);
+}
+
+void probe(const std::string& path, const std::vector<std::string>& sets, bool all) {
+  const dcm::Checkpoint c = dcm::read_checkpoint(path);
+  if (c.text("app") != "spread")
+    throw dcm::IoError(path + ": a checkpoint of '" + c.text("app") + "', not of spread");
+  dcm::Scene scene = dcm::Scene::from_string(c.text("scene"), path);
+  for (const std::string& s : sets) {
+    const std::string key = s.substr(0, s.find('='));
+    if (key.rfind("contact.", 0) != 0 && key.rfind("geometry.", 0) != 0 && key.rfind("cortex.E_Pa", 0) != 0 &&
+        key.rfind("cortex.nu", 0) != 0)
+      throw dcm::SceneError("--set " + s +
+                            ": only contact.*, geometry.*, cortex.E_Pa and cortex.nu may change "
+                            "(the shape is the checkpoint's)");
+    scene.set(s);
+  }
+  scene.validate();
+  dcm::CortexModel<Exec> model(Exec(), {dcm::HostCell(dcm::cell_mesh_from_scene(scene))},
+                               dcm::mechanics_from_scene(scene));
+  model.restore_state(c);
+  model.compute_forces();
+  const auto x = host(model.positions());
+  const auto tri = host(model.mesh().tri);
+  const auto& geo = model.geometry();
+  const auto radius = host(geo.tri_sphere_radius);
+  const auto centre = host(geo.tri_sphere_center);
+  const auto normal = host(geo.tri_normal);
+  const auto& cb = *model.contact();
+  const auto node_load = host(cb.tri_node_load);
+  const auto load = host(cb.tri_load);
+  const auto regime = host(cb.tri_regime);
+  const auto area_c = host(cb.tri_contact_area);
+  const double plane_z = scene.get_real("contact.plane_z_m");
+  const int n = model.mesh().n_nodes;
+  double cx = 0, cy = 0;
+  for (int i = 0; i < n; ++i) cx += x(i, 0) / n, cy += x(i, 1) / n;
+  std::printf("# %s at t = %.9g s; plane z = %g m; axis through the node centroid (%.6g, %.6g) m\n",
+              path.c_str(), c.scalar("stepper.t"), plane_z, cx, cy);
+  std::printf(
+      "triangle,r_m,z_min_m,z_max_m,normal_z,sphere_radius_m,sphere_overlap_m,regime,load_N,"
+      "node0,node1,node2,z0_m,z1_m,z2_m,f0_N,f1_N,f2_N,contact_area_m2\n");
+  for (int t = 0; t < model.mesh().n_tris; ++t) {
+    if (!all && regime(t) == dcm::kNoContact) continue;
+    double z[3], r = 0;
+    for (int k = 0; k < 3; ++k) {
+      const int i = tri(t, k);
+      z[k] = x(i, 2) - plane_z;
+      r += std::hypot(x(i, 0) - cx, x(i, 1) - cy) / 3;
+    }
+    std::printf("%d,%.6e,%.6e,%.6e,%.6f,%.6e,%.6e,%d,%.17g,%d,%d,%d,%.6e,%.6e,%.6e,%.17g,%.17g,%.17g,%.17g\n",
+                t, r, std::min({z[0], z[1], z[2]}), std::max({z[0], z[1], z[2]}), normal(t, 2), radius(t),
+                radius(t) - (centre(t, 2) - plane_z), regime(t), load(t), tri(t, 0), tri(t, 1), tri(t, 2),
+                z[0], z[1], z[2], node_load(t, 0), node_load(t, 1), node_load(t, 2), area_c(t));
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "contact-probe: per-triangle contact of a spread checkpoint with the plane, as CSV on stdout\n"
+      "(regime 0 none, 1 gap branch, 2 quadrature/exact, 3 small disc, 4 full contact; loads repulsive > 0)",
+      "contact-probe"};
+  std::string path;
+  std::vector<std::string> sets;
+  bool all = false;
+  app.add_option("CHECKPOINT", path, "checkpoint.h5 written by spread")->required();
+  app.add_option("--set", sets, "KEY=VALUE: change a contact.*, geometry.*, cortex.E_Pa or cortex.nu key");
+  app.add_flag("--all", all, "every triangle, also those without contact");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    dcm::KokkosSession kokkos(0);
+    probe(path, sets, all);
+  } catch (const dcm::SceneError& e) {
+    std::cerr << "contact-probe: error: " << e.what() << '\n';
+    return 2;
+  } catch (const dcm::IoError& e) {
+    std::cerr << "contact-probe: error: " << e.what() << '\n';
+    return 2;
+  } catch (const dcm::NumericalError& e) {
+    std::cerr << "contact-probe: error: " << e.what() << '\n';
+    return 3;
+  }
+  return 0;
+}
