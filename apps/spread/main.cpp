@@ -54,6 +54,7 @@ struct SpreadOptions {
   double early_from_s = 1e-2, early_to_s = 1e-1;
   std::string restart;      // checkpoint to continue from
   long long max_steps = 0;  // stop after this many steps (counted from the run's start), 0: no limit
+  bool check = false;       // validate the scene and options, write nothing, run nothing
 };
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -183,6 +184,10 @@ void run(const AppOptions& options, const SpreadOptions& so) {
   }
   const double dt = scene.get_real("time.dt_s"), t_end = scene.get_real("time.t_end_s");
   const TimeStepSettings step_settings = steps_from_scene(scene);
+  if (so.check) {  // everything above would have stopped a bad run; nothing is written
+    std::printf("spread: scene %s: ok (checked, nothing written)\n", scene.name().c_str());
+    return;
+  }
   const std::string out = restart
                               ? std::filesystem::path(so.restart).parent_path().lexically_normal().string()
                               : prepare_output_dir(options, scene);
@@ -508,6 +513,8 @@ int main(int argc, char** argv) {
   app.add_option("--max-steps", so.max_steps,
                  "Stop after this many steps in all (a checkpoint is written; --restart continues)")
       ->check(CLI::Range(1LL, 1000000000000LL));
+  app.add_flag("--check", so.check,
+               "Only check the scene and the options (exit 0, or 2 with the error); write and run nothing");
   return dcm::run_app(app, argc, argv, [&] {
     if (window.size() == 2) {
       so.early_from_s = window[0];

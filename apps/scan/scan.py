@@ -1,0 +1,323 @@
+#!/usr/bin/env python3
+"""scan: a parameter scan of spread runs (the paper's Figure 5 kind), described by a scan file.
+
+Stage 1 of issue 7 (docs/SCANS.md): every member is a spread run of its own, run by a pool of processes
+(--jobs at a time, each with --threads OpenMP threads); the batched engine and MPI are not done yet.
+
+  scan SCAN.toml [--out DIR] [--jobs N] [--threads T] [--dry-run] [--no-plot] [--quiet]
+
+Outputs in DIR (default out/<scan name>): members/<id>/ (each member's spread output), summary.csv (one row per
+member: id, status, the swept keys, the summary values), scan.h5 (a group per member: its parameters and
+summary as attributes, its series and final frame), scan.json (the members and their resolved --set
+arguments) and r_cc_grid.png (r_cc(t) per swept key). Running the same command again finishes what is
+missing: finished members are kept, interrupted ones continue from their checkpoint.
+Exit codes: 0 all members finished, 2 bad input (nothing written), 3 a member failed numerically, 130 stopped.
+"""
+import argparse, csv, itertools, json, math, os, shutil, signal, subprocess, sys, time
+
+try:
+    import tomllib
+except ImportError:  # Python < 3.11
+    tomllib = None
+
+PROG = "scan"
+SUMMARY_KEYS = ["r_cc_final_m", "contact_angle_deg", "contact_angle_free_deg", "early_exponent",
+                "height_final_m", "steps", "wall_s", "mean_cg_iterations"]
+
+
+class ScanError(Exception):
+    pass
+
+
+def fmt(v):
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, float):
+        return repr(v)
+    return str(v)
+
+
+def sweep_values(key, spec):
+    if isinstance(spec, list):
+        if not spec:
+            raise ScanError(f"sweep.{key} = [] is empty: give at least one value")
+        return spec
+    if isinstance(spec, dict):
+        allowed = {"start", "stop", "num", "spacing"}
+        extra = set(spec) - allowed
+        if extra:
+            raise ScanError(f"sweep.{key}: unknown field '{sorted(extra)[0]}' (allowed: start, stop, num, spacing)")
+        try:
+            start, stop, num = float(spec["start"]), float(spec["stop"]), int(spec["num"])
+        except (KeyError, TypeError, ValueError):
+            raise ScanError(f"sweep.{key} = {spec}: a range needs numbers start, stop and an integer num")
+        spacing = spec.get("spacing", "linear")
+        if not 1 <= num <= 1000:
+            raise ScanError(f"sweep.{key}.num = {num} is out of range: allowed 1 .. 1000")
+        if spacing not in ("linear", "log"):
+            raise ScanError(f"sweep.{key}.spacing = '{spacing}' is not allowed: choose linear or log")
+        if spacing == "log" and not (start > 0 and stop > 0):
+            raise ScanError(f"sweep.{key}: log spacing needs start > 0 and stop > 0 (got {start}, {stop})")
+        if num == 1:
+            return [start]
+        if spacing == "log":
+            a, b = math.log(start), math.log(stop)
+            return [math.exp(a + (b - a) * i / (num - 1)) for i in range(num)]
+        return [start + (stop - start) * i / (num - 1) for i in range(num)]
+    raise ScanError(f"sweep.{key} = {spec!r}: give a list of values or a table {{start, stop, num, spacing}}")
+
+
+def load_scan(path):
+    if tomllib is None:
+        raise ScanError("this Python has no tomllib (needs Python >= 3.11)")
+    try:
+        with open(path, "rb") as f:
+            doc = tomllib.load(f)
+    except FileNotFoundError:
+        raise ScanError(f"{path}: no such scan file")
+    except tomllib.TOMLDecodeError as e:
+        raise ScanError(f"{path}: not valid TOML: {e}")
+    allowed = {"name", "base", "mode", "set", "sweep"}
+    for k in doc:
+        if k not in allowed:
+            raise ScanError(f"{path}: unknown key '{k}' (allowed: {', '.join(sorted(allowed))})")
+    name = doc.get("name", os.path.splitext(os.path.basename(path))[0])
+    if not isinstance(name, str) or not name or any(c in name for c in "/\\ "):
+        raise ScanError(f"{path}: name = {name!r} is not allowed: a non-empty word without / or spaces")
+    base = doc.get("base")
+    if base is not None:
+        base = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(path)), base))
+        if not os.path.isfile(base):
+            raise ScanError(f"{path}: base = '{doc['base']}': no such scene file ({base})")
+    mode = doc.get("mode", "one_at_a_time")
+    if mode not in ("one_at_a_time", "grid"):
+        raise ScanError(f"{path}: mode = '{mode}' is not allowed: choose one_at_a_time or grid")
+    fixed = doc.get("set", {})
+    sweep = doc.get("sweep", {})
+    if not isinstance(fixed, dict) or not isinstance(sweep, dict):
+        raise ScanError(f"{path}: [set] and [sweep] must be tables of scene keys")
+    if not sweep:
+        raise ScanError(f"{path}: [sweep] is empty: give at least one scene key with its values")
+    for key in list(fixed) + list(sweep):
+        if isinstance(fixed.get(key, sweep.get(key)), dict) and key in fixed:
+            raise ScanError(f"{path}: set.{key}: write the key in quotes, e.g. \"{key}\" = value")
+    values = {k: sweep_values(k, v) for k, v in sweep.items()}
+    members = []  # (label, {key: value}) for the swept keys
+    if mode == "grid":
+        keys = list(values)
+        for combo in itertools.product(*(values[k] for k in keys)):
+            members.append(dict(zip(keys, combo)))
+    else:
+        members.append({})  # the base member: every swept key at the base scene's value
+        for k, vs in values.items():
+            for v in vs:
+                members.append({k: v})
+    out = []
+    for i, swept in enumerate(members):
+        sets = [f"{k}={fmt(v)}" for k, v in fixed.items()] + [f"{k}={fmt(v)}" for k, v in swept.items()]
+        label = ", ".join(f"{k}={fmt(v)}" for k, v in swept.items()) or "base"
+        out.append({"id": f"m{i:03d}", "label": label, "swept": swept, "sets": sets})
+    return {"name": name, "base": base, "mode": mode, "sweep_keys": list(values), "members": out}
+
+
+def spread_cmd(spread, scan, member, out_dir=None, extra=()):
+    cmd = [spread] + ([scan["base"]] if scan["base"] else [])
+    for s in member["sets"]:
+        cmd += ["--set", s]
+    if out_dir:
+        cmd += ["--out", out_dir]
+    return cmd + list(extra)
+
+
+def member_state(mdir, member):
+    """done, resume (a checkpoint of the same member), or new."""
+    try:
+        with open(os.path.join(mdir, "member.json")) as f:
+            if json.load(f)["sets"] != member["sets"]:
+                return "new"
+        with open(os.path.join(mdir, "summary.json")) as f:
+            s = json.load(f)
+        if not s.get("interrupted") and not s.get("stopped_at_max_steps"):
+            return "done"
+    except (OSError, ValueError, KeyError):
+        pass
+    return "resume" if os.path.isfile(os.path.join(mdir, "checkpoint.h5")) else "new"
+
+
+def collect(scan, out, spread_ok):
+    rows = []
+    for m in scan["members"]:
+        mdir = os.path.join(out, "members", m["id"])
+        row = {"id": m["id"], "status": spread_ok.get(m["id"], "not run")}
+        row.update({k: m["swept"].get(k, "") for k in scan["sweep_keys"]})
+        try:
+            with open(os.path.join(mdir, "summary.json")) as f:
+                s = json.load(f)
+            row.update({k: s.get(k, "") for k in SUMMARY_KEYS})
+        except (OSError, ValueError):
+            row.update({k: "" for k in SUMMARY_KEYS})
+        rows.append(row)
+    tmp = os.path.join(out, "summary.csv.part")
+    with open(tmp, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=["id", "status"] + scan["sweep_keys"] + SUMMARY_KEYS)
+        w.writeheader()
+        w.writerows(rows)
+    os.replace(tmp, os.path.join(out, "summary.csv"))
+    return rows
+
+
+def write_h5(scan, out, rows):
+    try:
+        import h5py
+    except ImportError:
+        print(f"{PROG}: warning: no h5py: scan.h5 not written", file=sys.stderr)
+        return
+    tmp = os.path.join(out, "scan.h5.part")
+    with h5py.File(tmp, "w") as dst:
+        dst.attrs["name"] = scan["name"]
+        dst.attrs["mode"] = scan["mode"]
+        g = dst.create_group("members")
+        for m, row in zip(scan["members"], rows):
+            mg = g.create_group(m["id"])
+            mg.attrs["label"] = m["label"]
+            mg.attrs["status"] = row["status"]
+            mg.attrs["sets"] = json.dumps(m["sets"])
+            for k, v in m["swept"].items():
+                mg.attrs["param:" + k] = v
+            for k in SUMMARY_KEYS:
+                if row.get(k, "") != "":
+                    mg.attrs[k] = row[k]
+            src_path = os.path.join(out, "members", m["id"], "spread.h5")
+            if not os.path.isfile(src_path):
+                continue
+            with h5py.File(src_path, "r") as src:
+                if "series" in src:
+                    src.copy(src["series"], mg, "series")
+                frames = sorted(src["frames"]) if "frames" in src else []
+                if frames:
+                    src.copy(src["frames"][frames[-1]], mg, "final_frame")
+    os.replace(tmp, os.path.join(out, "scan.h5"))
+
+
+def plot(scan, out):
+    plotter = os.path.join(os.path.dirname(os.path.abspath(__file__)), "scan_plot.py")
+    if not os.path.isfile(plotter):
+        plotter = os.path.join(os.environ.get("DCM_SOURCE_DIR", ""), "apps", "scan", "scan_plot.py")
+    r = subprocess.run([sys.executable, plotter, out], capture_output=True, text=True)
+    if r.returncode != 0:
+        print(f"{PROG}: warning: r_cc_grid.png not written: {r.stderr.strip().splitlines()[-1:]}", file=sys.stderr)
+
+
+def main():
+    ap = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0],
+                                 epilog="Scan files: scans/quick.toml, scans/figure5.toml; format in docs/SCANS.md.")
+    ap.add_argument("scan_file", metavar="SCAN.toml")
+    ap.add_argument("--out", help="output folder (default out/<scan name>)")
+    ap.add_argument("--jobs", type=int, default=0, help="members run at once (default: the number of cores)")
+    ap.add_argument("--threads", type=int, default=0, help="OpenMP threads per member (default: cores / jobs)")
+    ap.add_argument("--dry-run", action="store_true", help="list the members and their --set arguments, run nothing")
+    ap.add_argument("--no-plot", action="store_true", help="do not draw r_cc_grid.png")
+    ap.add_argument("--quiet", action="store_true", help="print only errors")
+    ap.add_argument("--spread", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "spread"),
+                    help=argparse.SUPPRESS)
+    a = ap.parse_args()
+    cores = os.cpu_count() or 1
+    try:
+        if a.jobs < 0 or a.jobs > 1024:
+            raise ScanError(f"--jobs = {a.jobs} is out of range: allowed 1 .. 1024 (0: the number of cores)")
+        if a.threads < 0 or a.threads > 1024:
+            raise ScanError(f"--threads = {a.threads} is out of range: allowed 1 .. 1024 (0: cores / jobs)")
+        scan = load_scan(a.scan_file)
+        jobs = a.jobs or cores
+        threads = a.threads or max(1, cores // jobs)
+        if a.dry_run:
+            for m in scan["members"]:
+                print(m["id"], m["label"], " ".join(f"--set {s}" for s in m["sets"]))
+            return 0
+        for m in scan["members"]:  # every member's scene checked before anything is written
+            r = subprocess.run(spread_cmd(a.spread, scan, m, extra=["--check"]), capture_output=True, text=True)
+            if r.returncode != 0:
+                msg = (r.stderr.strip().splitlines() or ["spread --check failed"])[-1]
+                raise ScanError(f"member {m['id']} ({m['label']}): {msg}")
+        out = a.out or os.path.join("out", scan["name"])
+        try:
+            os.makedirs(os.path.join(out, "members"), exist_ok=True)
+            with open(os.path.join(out, "scan.json.part"), "w") as f:
+                json.dump(scan, f, indent=1)
+            os.replace(os.path.join(out, "scan.json.part"), os.path.join(out, "scan.json"))
+        except OSError as e:
+            raise ScanError(f"--out {out}: cannot write there ({e.strerror})")
+    except ScanError as e:
+        print(f"{PROG}: error: {e}", file=sys.stderr)
+        return 2
+
+    status = {}
+    todo = []
+    for m in scan["members"]:
+        mdir = os.path.join(out, "members", m["id"])
+        state = member_state(mdir, m)
+        if state == "done":
+            status[m["id"]] = "done"
+        else:
+            todo.append((m, state))
+    if not a.quiet:
+        print(f"{PROG}: {scan['name']}: {len(scan['members'])} members, {len(scan['members']) - len(todo)} already "
+              f"done; {jobs} at a time, {threads} thread(s) each -> {out}", flush=True)
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads), OMP_PROC_BIND="false")
+    running = {}
+    stop = False
+    t0 = time.time()
+    finished = 0
+
+    def on_signal(sig, frame):
+        nonlocal stop
+        stop = True
+    signal.signal(signal.SIGINT, on_signal)
+    signal.signal(signal.SIGTERM, on_signal)
+    queue = list(todo)
+    while (queue and not stop) or running:
+        while queue and not stop and len(running) < jobs:
+            m, state = queue.pop(0)
+            mdir = os.path.join(out, "members", m["id"])
+            if state == "resume":
+                cmd = [a.spread, "--restart", os.path.join(mdir, "checkpoint.h5"), "--quiet", "--no-plot"]
+            else:
+                shutil.rmtree(mdir, ignore_errors=True)
+                cmd = spread_cmd(a.spread, scan, m, mdir, ["--quiet", "--no-plot"])
+            os.makedirs(mdir, exist_ok=True)
+            with open(os.path.join(mdir, "member.json"), "w") as f:
+                json.dump(m, f, indent=1)
+            log = open(os.path.join(mdir, "spread.log"), "w")
+            running[m["id"]] = (subprocess.Popen(cmd, env=env, stdout=log, stderr=subprocess.STDOUT), m, time.time(), log)
+        time.sleep(0.05)
+        for mid, (p, m, started, log) in list(running.items()):
+            rc = p.poll()
+            if rc is None:
+                continue
+            log.close()
+            del running[mid]
+            finished += 1
+            status[mid] = {0: "done", 3: "failed (numerical)", 130: "interrupted"}.get(rc, f"failed (exit {rc})")
+            if not a.quiet:
+                print(f"[{finished}/{len(todo)}] {mid} {m['label']}: {status[mid]} in {time.time() - started:.1f} s",
+                      flush=True)
+            if stop:
+                continue
+        if stop:
+            for p, *_ in running.values():
+                if p.poll() is None:
+                    p.send_signal(signal.SIGINT)
+    rows = collect(scan, out, status)
+    write_h5(scan, out, rows)
+    if not a.no_plot and not stop:
+        plot(scan, out)
+    if not a.quiet:
+        print(f"{PROG}: wrote {out}/summary.csv, {out}/scan.h5 ({time.time() - t0:.1f} s)", flush=True)
+    if stop:
+        print(f"{PROG}: stopped; run the same command again to finish the missing members", file=sys.stderr)
+        return 130
+    return 3 if any(s.startswith("failed") for s in status.values()) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,209 @@
+// bench_step: whole time steps of the two kinds of scene, on every execution space of this Kokkos build, with
+// the time of each Kokkos kernel taken from the Kokkos Tools callbacks (Kokkos fences around each kernel, so
+// the times are the kernels' own, on the CPU backends and on CUDA alike):
+//   stretch: the paper's optical-tweezers cell, ±100 pN on the outermost 5% of the nodes at each end, no
+//   plane; spread:  the sphered cell pressed 50 nm into the adhesive plane (contact from the first step);
+//   diagonal: the stretch scene without dashpots, global area and volume terms (always implicit when present)
+//            and implicit terms (Δt = 0.1 µs): Γ is the drag alone, a diagonal the solve inverts per node
+//            without a CG iteration (what a scene does not need costs nothing).
+// Table 1 parameters and the solver defaults of the scenes (multigrid PCG to 1e-14 N, implicit bending and
+// tension). One row per (space, threads, scene, nodes, kernel): µs per step and ns per node per step; the
+// kernel "step" is the whole step (host work, copies and fences included), "other" what no kernel covers.
+//   bench_step [--levels 3,4,5,6] [--scenes stretch,spread,diagonal] [--steps N] [--warmup N] [--threads 1,2]
+// Each OpenMP thread count runs in a child process of this binary (OMP_NUM_THREADS is fixed at Kokkos start);
+// Serial runs once, in the first. CSV on stdout (docs/PERFORMANCE.md turns it into tables).
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "apps/common/mechanics_setup.hpp"
+#include "apps/common/stretch_setup.hpp"
+#include "core/kokkos_compat.hpp"
+#include "core/scene.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Kokkos Tools: accumulated seconds per kernel label.
+struct KernelTimes {
+  std::map<std::string, double> seconds;
+  std::vector<std::pair<std::string, Clock::time_point>> open;  // indexed by the kernel id handed out
+  bool on = false;
+};
+KernelTimes g_times;
+
+void begin_kernel(const char* name, std::uint32_t, std::uint64_t* id) {
+  *id = g_times.open.size();
+  g_times.open.emplace_back(name, Clock::now());
+}
+void end_kernel(std::uint64_t id) {
+  const auto& [name, t0] = g_times.open[id];
+  if (g_times.on) g_times.seconds[name] += std::chrono::duration<double>(Clock::now() - t0).count();
+  if (id + 1 == g_times.open.size()) g_times.open.pop_back();
+}
+void install_kernel_timer() {
+  namespace KT = Kokkos::Tools::Experimental;
+  KT::set_begin_parallel_for_callback(begin_kernel);
+  KT::set_end_parallel_for_callback(end_kernel);
+  KT::set_begin_parallel_reduce_callback(begin_kernel);
+  KT::set_end_parallel_reduce_callback(end_kernel);
+  KT::set_begin_parallel_scan_callback(begin_kernel);
+  KT::set_end_parallel_scan_callback(end_kernel);
+}
+
+struct Options {
+  std::vector<int> levels{3, 4, 5, 6};
+  std::vector<std::string> scenes{"stretch", "spread", "diagonal"};
+  std::vector<int> threads{1, 2};
+  int steps = 20, warmup = 5;
+  bool child = false, serial = true;
+};
+
+dcm::Scene scene_for(const std::string& kind, int level) {
+  dcm::Scene s = dcm::Scene::defaults();
+  s.set("mesh.nodes=" + std::to_string(10 * (1 << (2 * level)) + 2));
+  if (kind == "stretch" || kind == "diagonal") {
+    s.set("contact.plane=false");
+  }
+  if (kind == "diagonal") {
+    for (const char* k :
+         {"cortex.c_N_s_per_m=0", "cortex.k_d=0", "cortex.k_v=0", "solver.implicit_bending=false",
+          "solver.implicit_tension=false", "solver.implicit_bonds=false", "time.dt_s=1e-7"})
+      s.set(k);
+  } else if (kind == "spread") {
+    s.set("contact.plane=true");
+    s.set("contact.start_gap_m=-50e-9");
+  }
+  s.validate();
+  return s;
+}
+
+template <class Exec>
+void run_case(const std::string& space_name, int threads, const std::string& kind, int level,
+              const Options& o) {
+  const dcm::Scene scene = scene_for(kind, level);
+  dcm::HostMesh mesh = dcm::cell_mesh_from_scene(scene);
+  if (kind == "spread") {
+    double zmin = 1e300;
+    for (const auto& x : mesh.nodes) zmin = std::min(zmin, x[2]);
+    for (auto& x : mesh.nodes) x[2] += scene.get_real("contact.start_gap_m") - zmin;
+  }
+  dcm::CortexModel<Exec> model(Exec(), {dcm::HostCell(mesh)}, dcm::mechanics_from_scene(scene));
+  const int n = model.mesh().n_nodes;
+  if (kind != "spread") {
+    const auto [left, right] = dcm::pulled_nodes(mesh, 0.05);
+    auto f = Kokkos::create_mirror_view(model.external_force());
+    Kokkos::deep_copy(f, 0.0);
+    for (int i : left) f(i, 0) = -100e-12 / left.size();
+    for (int i : right) f(i, 0) = 100e-12 / right.size();
+    Kokkos::deep_copy(model.external_force(), f);
+  }
+  dcm::TimeStepper<Exec> stepper(n, dcm::steps_from_scene(scene));
+  const dcm::CgSettings cg = dcm::cg_settings_from_scene(scene);
+  for (int s = 0; s < o.warmup; ++s) stepper.step(model, cg, 1.0, [](double) {});
+  g_times.seconds.clear();
+  g_times.on = true;
+  long iterations = 0;
+  const auto t0 = Clock::now();
+  for (int s = 0; s < o.steps; ++s) iterations += stepper.step(model, cg, 1.0, [](double) {}).iterations;
+  const double step_s = std::chrono::duration<double>(Clock::now() - t0).count() / o.steps;
+  g_times.on = false;
+  const auto row = [&](const std::string& kernel, double seconds_per_step) {
+    std::printf("%s,%d,%s,%d,%s,%.3f,%.2f,%.2f\n", space_name.c_str(), threads, kind.c_str(), n,
+                kernel.c_str(), seconds_per_step * 1e6, seconds_per_step * 1e9 / n,
+                static_cast<double>(iterations) / o.steps);
+  };
+  double covered = 0;
+  for (const auto& [name, sec] : g_times.seconds) {
+    row(name, sec / o.steps);
+    covered += sec / o.steps;
+  }
+  row("other", step_s - covered);
+  row("step", step_s);
+  std::fflush(stdout);
+}
+
+void run_all(const Options& o, int threads) {
+  for (const std::string& kind : o.scenes)
+    for (int level : o.levels) {
+      if (o.serial) run_case<Kokkos::Serial>("Serial", 1, kind, level, o);
+#if defined(KOKKOS_ENABLE_OPENMP)
+      run_case<Kokkos::OpenMP>("OpenMP", threads, kind, level, o);
+#endif
+#if defined(KOKKOS_ENABLE_CUDA)
+      run_case<Kokkos::Cuda>("Cuda", 0, kind, level, o);
+#endif
+    }
+}
+
+std::string join(const std::vector<int>& v) {
+  std::string s;
+  for (int x : v) s += (s.empty() ? "" : ",") + std::to_string(x);
+  return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"bench_step: per-kernel time of whole steps (stretch and spread scenes) on every backend, CSV",
+               "bench_step"};
+  Options o;
+  std::string scenes = "stretch,spread,diagonal";
+  app.add_option("--levels", o.levels, "icosphere levels (3: 642 nodes ... 6: 40962)")
+      ->delimiter(',')
+      ->check(CLI::Range(0, 6));
+  app.add_option("--scenes", scenes, "stretch, spread, diagonal (comma-separated)");
+  app.add_option("--threads", o.threads, "OpenMP thread counts, one child process each")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 1024));
+  app.add_option("--steps", o.steps, "timed steps per case")->check(CLI::Range(1, 1000000));
+  app.add_option("--warmup", o.warmup, "untimed steps first")->check(CLI::Range(0, 1000000));
+  app.add_flag("--child", o.child, "(internal) run one thread count, no header, no Serial unless --serial");
+  app.add_flag("--serial,!--no-serial", o.serial, "also time the Serial space");
+  CLI11_PARSE(app, argc, argv);
+  o.scenes.clear();
+  std::stringstream ss(scenes);
+  for (std::string k; std::getline(ss, k, ',');) {
+    if (k != "stretch" && k != "spread" && k != "diagonal") {
+      std::cerr << "bench_step: error: --scenes: '" << k
+                << "' is not allowed: choose stretch, spread, diagonal\n";
+      return 2;
+    }
+    o.scenes.push_back(k);
+  }
+  if (o.child) {
+    dcm::KokkosSession kokkos;
+    install_kernel_timer();
+    run_all(o, std::atoi(std::getenv("OMP_NUM_THREADS") ? std::getenv("OMP_NUM_THREADS") : "0"));
+    return 0;
+  }
+  std::printf("space,threads,scene,nodes,kernel,us_per_step,ns_per_node,cg_iterations_per_step\n");
+  std::fflush(stdout);
+  char self[4096];
+  const ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
+  if (len <= 0) {
+    std::cerr << "bench_step: error: cannot find this program's path (/proc/self/exe)\n";
+    return 1;
+  }
+  self[len] = '\0';
+  for (std::size_t k = 0; k < o.threads.size(); ++k) {
+    const std::string cmd = "OMP_NUM_THREADS=" + std::to_string(o.threads[k]) + " OMP_PROC_BIND=false '" +
+                            self + "' --child --levels " + join(o.levels) + " --scenes " + scenes +
+                            " --steps " + std::to_string(o.steps) + " --warmup " + std::to_string(o.warmup) +
+                            (k == 0 && o.serial ? " --serial" : " --no-serial");
+    if (std::system(cmd.c_str()) != 0) {
+      std::cerr << "bench_step: error: the run with " << o.threads[k] << " OpenMP threads failed\n";
+      return 1;
+    }
+  }
+  return 0;
+}
