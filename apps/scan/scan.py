@@ -153,7 +153,7 @@ def collect(scan, out, spread_ok):
         try:
             with open(os.path.join(mdir, "summary.json")) as f:
                 s = json.load(f)
-            row.update({k: s.get(k, "") for k in SUMMARY_KEYS})
+            row.update({k: ("" if s.get(k) is None else s[k]) for k in SUMMARY_KEYS})  # null: not measured
         except (OSError, ValueError):
             row.update({k: "" for k in SUMMARY_KEYS})
         rows.append(row)
