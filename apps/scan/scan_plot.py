@@ -51,6 +51,9 @@ def main():
             t0, t1 = min(all_t), max(all_t)
             ts = [t0 * (t1 / t0) ** (k / 20) for k in range(21)]
             ax.loglog(ts, [1.0 * (tt / 0.1) ** 0.5 for tt in ts], color="0.6", lw=0.8, ls=":", label="t^1/2")
+        all_r = [v for m in members for v in series(out, m["id"])[1]]
+        if all_r:  # the first touch-down (r_cc of nanometres) would squash the curves
+            ax.set_ylim(bottom=max(min(all_r), 0.03 * max(all_r)), top=1.3 * max(all_r))
         ax.set_title(key, fontsize=9)
         ax.set_xlabel("t (s)")
         ax.set_ylabel("r_cc (µm)")
