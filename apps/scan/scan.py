@@ -214,7 +214,8 @@ def main():
     ap.add_argument("scan_file", metavar="SCAN.toml")
     ap.add_argument("--out", help="output folder (default out/<scan name>)")
     ap.add_argument("--jobs", type=int, default=0, help="members run at once (default: the number of cores)")
-    ap.add_argument("--threads", type=int, default=0, help="OpenMP threads per member (default: cores / jobs)")
+    ap.add_argument("--threads", type=int, default=0,
+                    help="OpenMP threads per member (default: cores / members run at once)")
     ap.add_argument("--dry-run", action="store_true", help="list the members and their --set arguments, run nothing")
     ap.add_argument("--no-plot", action="store_true", help="do not draw r_cc_grid.png")
     ap.add_argument("--quiet", action="store_true", help="print only errors")
@@ -226,10 +227,9 @@ def main():
         if a.jobs < 0 or a.jobs > 1024:
             raise ScanError(f"--jobs = {a.jobs} is out of range: allowed 1 .. 1024 (0: the number of cores)")
         if a.threads < 0 or a.threads > 1024:
-            raise ScanError(f"--threads = {a.threads} is out of range: allowed 1 .. 1024 (0: cores / jobs)")
+            raise ScanError(f"--threads = {a.threads} is out of range: allowed 1 .. 1024 (0: cores / members run at once)")
         scan = load_scan(a.scan_file)
         jobs = a.jobs or cores
-        threads = a.threads or max(1, cores // jobs)
         if a.dry_run:
             for m in scan["members"]:
                 print(m["id"], m["label"], " ".join(f"--set {s}" for s in m["sets"]))
@@ -260,11 +260,14 @@ def main():
             status[m["id"]] = "done"
         else:
             todo.append((m, state))
+    # Fewer members to run than jobs: the cores go to the members as threads.
+    threads = a.threads or max(1, cores // max(1, min(jobs, len(todo))))
     if not a.quiet:
         print(f"{PROG}: {scan['name']}: {len(scan['members'])} members, {len(scan['members']) - len(todo)} already "
               f"done; {jobs} at a time, {threads} thread(s) each -> {out}", flush=True)
     env = dict(os.environ, OMP_NUM_THREADS=str(threads), OMP_PROC_BIND="false")
     running = {}
+    signalled = set()
     stop = False
     t0 = time.time()
     finished = 0
@@ -301,12 +304,11 @@ def main():
             if not a.quiet:
                 print(f"[{finished}/{len(todo)}] {mid} {m['label']}: {status[mid]} in {time.time() - started:.1f} s",
                       flush=True)
-            if stop:
-                continue
-        if stop:
-            for p, *_ in running.values():
-                if p.poll() is None:
+        if stop:  # each running member once: it writes its checkpoint and stops
+            for mid, (p, *_) in running.items():
+                if mid not in signalled and p.poll() is None:
                     p.send_signal(signal.SIGINT)
+                    signalled.add(mid)
     rows = collect(scan, out, status)
     write_h5(scan, out, rows)
     if not a.no_plot and not stop:
