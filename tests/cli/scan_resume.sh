@@ -8,7 +8,7 @@ scan=$1 py=$2 file=$3 out=$4 full=$5
 rm -rf "$out"
 "$scan" "$file" --out "$out" --jobs 1 --threads 1 --no-plot --quiet &
 pid=$!
-for _ in $(seq 100); do  # stop once the first member is done and the second has started
+for _ in $(seq 1200); do  # stop once the first member is done and the second has started (60 s at most)
   [ -f "$out/members/m000/summary.json" ] && [ -f "$out/members/m001/spread.log" ] && break
   sleep 0.05
 done
@@ -18,7 +18,7 @@ code=$?
 [ $code = 130 ] || { echo "interrupted scan: exit $code, expected 130"; exit 1; }
 before=$(stat -c %Y "$out/members/m000/summary.json")
 "$scan" "$file" --out "$out" --jobs 1 --threads 1 --no-plot > "$out.log" 2>&1 || { cat "$out.log"; exit 1; }
-grep -q "1 already done\|2 already done" "$out.log" || { echo "resume did not keep the finished members:"; cat "$out.log"; exit 1; }
+grep -q "[123] already done" "$out.log" || { echo "resume did not keep the finished members:"; cat "$out.log"; exit 1; }
 [ "$(stat -c %Y "$out/members/m000/summary.json")" = "$before" ] || { echo "m000 was run again"; exit 1; }
 "$py" - "$out" "$full" <<'PY' || exit 1
 import csv, sys
