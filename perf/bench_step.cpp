@@ -10,6 +10,8 @@
 // tension). One row per (space, threads, scene, nodes, kernel): µs per step and ns per node per step; the
 // kernel "step" is the whole step (host work, copies and fences included), "other" what no kernel covers.
 //   bench_step [--levels 3,4,5,6] [--scenes stretch,spread,diagonal] [--steps N] [--warmup N] [--threads 1,2]
+//              [--set KEY=VALUE]...
+//              [--set KEY=VALUE]...
 // Each OpenMP thread count runs in a child process of this binary (OMP_NUM_THREADS is fixed at Kokkos start);
 // Serial runs once, in the first. CSV on stdout (docs/PERFORMANCE.md turns it into tables).
 #include <unistd.h>
@@ -66,9 +68,10 @@ struct Options {
   std::vector<int> threads{1, 2};
   int steps = 20, warmup = 5;
   bool child = false, serial = true;
+  std::vector<std::string> sets;  // scene overrides for every case (applied last)
 };
 
-dcm::Scene scene_for(const std::string& kind, int level) {
+dcm::Scene scene_for(const std::string& kind, int level, const std::vector<std::string>& sets) {
   dcm::Scene s = dcm::Scene::defaults();
   s.set("mesh.nodes=" + std::to_string(10 * (1 << (2 * level)) + 2));
   if (kind == "stretch" || kind == "diagonal") {
@@ -83,6 +86,7 @@ dcm::Scene scene_for(const std::string& kind, int level) {
     s.set("contact.plane=true");
     s.set("contact.start_gap_m=-50e-9");
   }
+  for (const std::string& set : sets) s.set(set);
   s.validate();
   return s;
 }
@@ -90,7 +94,7 @@ dcm::Scene scene_for(const std::string& kind, int level) {
 template <class Exec>
 void run_case(const std::string& space_name, int threads, const std::string& kind, int level,
               const Options& o) {
-  const dcm::Scene scene = scene_for(kind, level);
+  const dcm::Scene scene = scene_for(kind, level, o.sets);
   dcm::HostMesh mesh = dcm::cell_mesh_from_scene(scene);
   if (kind == "spread") {
     double zmin = 1e300;
@@ -167,6 +171,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 1024));
   app.add_option("--steps", o.steps, "timed steps per case")->check(CLI::Range(1, 1000000));
   app.add_option("--warmup", o.warmup, "untimed steps first")->check(CLI::Range(0, 1000000));
+  app.add_option("--set", o.sets, "KEY=VALUE: a scene key for every case, e.g. --set solver.cg_abs_tol_N=4e-14");
   app.add_flag("--child", o.child, "(internal) run one thread count, no header, no Serial unless --serial");
   app.add_flag("--serial,!--no-serial", o.serial, "also time the Serial space");
   CLI11_PARSE(app, argc, argv);
@@ -196,10 +201,11 @@ int main(int argc, char** argv) {
   }
   self[len] = '\0';
   for (std::size_t k = 0; k < o.threads.size(); ++k) {
-    const std::string cmd = "OMP_NUM_THREADS=" + std::to_string(o.threads[k]) + " OMP_PROC_BIND=false '" +
+    std::string cmd = "OMP_NUM_THREADS=" + std::to_string(o.threads[k]) + " OMP_PROC_BIND=false '" +
                             self + "' --child --levels " + join(o.levels) + " --scenes " + scenes +
                             " --steps " + std::to_string(o.steps) + " --warmup " + std::to_string(o.warmup) +
                             (k == 0 && o.serial ? " --serial" : " --no-serial");
+    for (const std::string& set : o.sets) cmd += " --set '" + set + "'";
     if (std::system(cmd.c_str()) != 0) {
       std::cerr << "bench_step: error: the run with " << o.threads[k] << " OpenMP threads failed\n";
       return 1;
