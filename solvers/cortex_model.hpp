@@ -289,9 +289,12 @@ class CortexModel {
             apply_block_jacobi(space_, friction_, in, out);
         },
         force_, velocity_, cg_, settings);
-    if (!r.converged && !(r.residual_norm < INFINITY))
-      throw NumericalError("conjugate gradients diverged (residual " + std::to_string(r.residual_norm) +
-                           " N)");
+    if (!r.converged && !(r.residual_norm < INFINITY)) {
+      const int bad_v = first_non_finite_node(space_, velocity_);
+      throw NumericalError(std::string("conjugate gradients diverged: the residual is not finite") +
+                           (bad_v >= 0 ? " (the velocity of node " + std::to_string(bad_v) + " first)" : "") +
+                           "; the largest force is at node " + std::to_string(largest_force_node()));
+    }
     if (!r.converged && throw_if_unconverged) throw NumericalError(unconverged_message(r, settings));
     const int bad = first_non_finite_node(space_, velocity_);
     if (bad >= 0)
