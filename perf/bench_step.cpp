@@ -171,7 +171,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 1024));
   app.add_option("--steps", o.steps, "timed steps per case")->check(CLI::Range(1, 1000000));
   app.add_option("--warmup", o.warmup, "untimed steps first")->check(CLI::Range(0, 1000000));
-  app.add_option("--set", o.sets, "KEY=VALUE: a scene key for every case, e.g. --set solver.cg_abs_tol_N=4e-14");
+  app.add_option("--set", o.sets,
+                 "KEY=VALUE: a scene key for every case, e.g. --set solver.cg_abs_tol_N=4e-14");
   app.add_flag("--child", o.child, "(internal) run one thread count, no header, no Serial unless --serial");
   app.add_flag("--serial,!--no-serial", o.serial, "also time the Serial space");
   CLI11_PARSE(app, argc, argv);
@@ -201,10 +202,10 @@ int main(int argc, char** argv) {
   }
   self[len] = '\0';
   for (std::size_t k = 0; k < o.threads.size(); ++k) {
-    std::string cmd = "OMP_NUM_THREADS=" + std::to_string(o.threads[k]) + " OMP_PROC_BIND=false '" +
-                            self + "' --child --levels " + join(o.levels) + " --scenes " + scenes +
-                            " --steps " + std::to_string(o.steps) + " --warmup " + std::to_string(o.warmup) +
-                            (k == 0 && o.serial ? " --serial" : " --no-serial");
+    std::string cmd = "OMP_NUM_THREADS=" + std::to_string(o.threads[k]) + " OMP_PROC_BIND=false '" + self +
+                      "' --child --levels " + join(o.levels) + " --scenes " + scenes + " --steps " +
+                      std::to_string(o.steps) + " --warmup " + std::to_string(o.warmup) +
+                      (k == 0 && o.serial ? " --serial" : " --no-serial");
     for (const std::string& set : o.sets) cmd += " --set '" + set + "'";
     if (std::system(cmd.c_str()) != 0) {
       std::cerr << "bench_step: error: the run with " << o.threads[k] << " OpenMP threads failed\n";

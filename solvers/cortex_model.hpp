@@ -150,6 +150,19 @@ class CortexModel {
     from_host_vector(velocity_, c.array("model.v", size));
     update_geometry(space_, mesh_, geo_, params_.h_min);
   }
+  // Rest-state edits for shape finding (apps/deflate): every cell's target volume times `factor` (no-op
+  // without a volume term), and flat hinges (θ* = 0: no spontaneous curvature; no-op without bending).
+  void scale_rest_volume(double factor) {
+    if (!volume_) return;
+    const auto v = volume_->cell_volume;
+    Kokkos::parallel_for(
+        "dcm::model::scale_rest_volume", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, v.extent(0)),
+        KOKKOS_LAMBDA(const int c) { v(c) *= factor; });
+    space_.fence();
+  }
+  void set_flat_bending_rest() {
+    if (hinges_) set_hinge_rest_angles(*hinges_, {0.0});
+  }
   // Largest d / d_max over the bonds at the current positions (0 without bonds).
   double max_bond_extension() const {
     if (!bonds_) return 0.0;

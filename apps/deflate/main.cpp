@@ -1,0 +1,183 @@
+// deflate: the paper's biconcave start (MODEL.md section 1; paper, "Materials and methods"): a sphered cell
+// whose target volume is lowered to a fraction of the sphere's and relaxed to mechanical equilibrium. The
+// sphere is the rest state of the bonds and the area terms; the hinges rest flat (no spontaneous curvature).
+// Quasi-static deflation of the sphere ends on the stomatocyte side; starting from the sphere squashed along
+// z
+// (--squash, the rest state unchanged) it ends biconcave. Outputs in --out: summary.json (area, volume,
+// reduced volume, diameter, centre and largest thickness, against the Evans–Fung cell), profile.csv
+// (thickness against the distance from the axis), shape.csv (the node positions). docs/VALIDATION.md,
+// "Biconcave start".
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "apps/common/mechanics_setup.hpp"
+#include "core/errors.hpp"
+#include "core/host_copy.hpp"
+#include "core/json_writer.hpp"
+#include "core/scene.hpp"
+#include "solvers/newton_equilibrium.hpp"
+
+namespace {
+
+using Exec = Kokkos::DefaultExecutionSpace;
+
+struct Options {
+  int nodes = 642;
+  double volume_fraction = 0.644;  // the Evans–Fung cell's reduced volume
+  double squash = 0.45;            // z scale of the start (1: the sphere itself)
+  std::string out = "out/deflate";
+  bool quiet = false;
+};
+
+int level_of(int nodes) {
+  for (int k = 0; k <= 6; ++k)
+    if (10 * (1 << (2 * k)) + 2 == nodes) return k;
+  return -1;
+}
+
+void run(const Options& o) {
+  const int level = level_of(o.nodes);
+  if (level < 2 || level > 5)
+    throw dcm::SceneError("--nodes = " + std::to_string(o.nodes) +
+                          " is not allowed: choose 162, 642, 2562 or 10242 (icosphere node counts)");
+  if (!(o.volume_fraction >= 0.3 && o.volume_fraction <= 1))
+    throw dcm::SceneError("--volume-fraction = " + std::to_string(o.volume_fraction) +
+                          " is out of range: allowed 0.3 .. 1");
+  if (!(o.squash >= 0.1 && o.squash <= 1))
+    throw dcm::SceneError("--squash = " + std::to_string(o.squash) + " is out of range: allowed 0.1 .. 1");
+  std::error_code ec;
+  std::filesystem::create_directories(o.out, ec);
+  if (ec || !std::filesystem::is_directory(o.out))
+    throw dcm::IoError("--out " + o.out + ": cannot create the folder (" + ec.message() + ")");
+  dcm::Scene scene = dcm::Scene::defaults();  // Table 1 cortex
+  scene.set("mesh.nodes=" + std::to_string(o.nodes));
+  scene.set("contact.plane=false");
+  scene.validate();
+  const dcm::HostMesh sphere = dcm::cell_mesh_from_scene(scene);
+  dcm::CortexModel<Exec> model(Exec(), {dcm::HostCell(sphere)}, dcm::mechanics_from_scene(scene));
+  model.set_flat_bending_rest();
+  {
+    auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), model.positions());
+    for (std::size_t i = 0; i < x.extent(0); ++i) x(i, 2) *= o.squash;
+    Kokkos::deep_copy(model.positions(), x);
+  }
+  model.scale_rest_volume(o.volume_fraction);
+  dcm::NewtonSettings ns;
+  ns.force_tol = 1e-16;
+  ns.max_newton_steps = 1000;
+  const double edge = 4.0 * scene.get_real("mesh.radius_m") / std::sqrt(static_cast<double>(o.nodes));
+  const dcm::NewtonResult r = dcm::newton_equilibrium(model, ns, edge);
+  if (!r.converged)
+    throw dcm::NumericalError("no equilibrium after " + std::to_string(r.newton_steps) +
+                              " Newton steps (largest force " + std::to_string(r.max_force) + " N)");
+  model.compute_forces();  // geometry of the final shape
+  const auto x = dcm::to_host_vector(model.positions());
+  const double area = dcm::to_host_vector(model.geometry().cell_area)[0];
+  const double volume = dcm::to_host_vector(model.geometry().cell_volume)[0];
+  const double pi = std::acos(-1.0);
+  const double reduced = 6 * std::sqrt(pi) * volume / std::pow(area, 1.5);
+  // Symmetry axis: z (the squash direction); centre: the node centroid.
+  const int n = o.nodes;
+  double c[3] = {0, 0, 0};
+  for (int i = 0; i < n; ++i)
+    for (int d = 0; d < 3; ++d) c[d] += x[3 * i + d] / n;
+  double rho_max = 0;
+  for (int i = 0; i < n; ++i) rho_max = std::max(rho_max, std::hypot(x[3 * i] - c[0], x[3 * i + 1] - c[1]));
+  const int bins = std::max(4, static_cast<int>(std::lround(std::sqrt(n / 4.0))));
+  std::vector<double> lo(bins, 1e300), hi(bins, -1e300);
+  for (int i = 0; i < n; ++i) {
+    const double rho = std::hypot(x[3 * i] - c[0], x[3 * i + 1] - c[1]);
+    const int b = std::min(bins - 1, static_cast<int>(rho / rho_max * bins));
+    lo[b] = std::min(lo[b], x[3 * i + 2]);
+    hi[b] = std::max(hi[b], x[3 * i + 2]);
+  }
+  std::ofstream prof(o.out + "/profile.csv");
+  prof << "rho_m,thickness_m\n";
+  double t_centre = NAN, t_max = 0, rho_at_max = 0;
+  for (int b = 0; b < bins; ++b) {
+    if (!(hi[b] >= lo[b])) continue;
+    const double rho = (b + 0.5) / bins * rho_max, t = hi[b] - lo[b];
+    if (std::isnan(t_centre)) t_centre = t;
+    if (t > t_max) t_max = t, rho_at_max = rho;
+    char line[96];
+    std::snprintf(line, sizeof line, "%.9g,%.9g\n", rho, t);
+    prof << line;
+  }
+  std::ofstream shape(o.out + "/shape.csv");
+  shape << "x_m,y_m,z_m\n";
+  for (int i = 0; i < n; ++i) {
+    char line[96];
+    std::snprintf(line, sizeof line, "%.12g,%.12g,%.12g\n", x[3 * i], x[3 * i + 1], x[3 * i + 2]);
+    shape << line;
+  }
+  if (!prof || !shape) throw dcm::IoError(o.out + ": cannot write profile.csv / shape.csv");
+  const double sphere_area = 4 * pi * std::pow(scene.get_real("mesh.radius_m"), 2);
+  dcm::JsonObject json;
+  json.add("nodes", n)
+      .add("volume_fraction_target", o.volume_fraction)
+      .add("squash", o.squash)
+      .add("newton_steps", r.newton_steps)
+      .add("max_force_N", r.max_force)
+      .add("area_m2", area)
+      .add("area_over_sphere", area / sphere_area)
+      .add("volume_m3", volume)
+      .add("reduced_volume", reduced)
+      .add("diameter_m", 2 * rho_max)
+      .add("thickness_centre_m", t_centre)
+      .add("thickness_max_m", t_max)
+      .add("rho_of_thickness_max_m", rho_at_max)
+      .add("biconcave", t_centre < t_max)
+      .add("evans_fung_diameter_m", 7.82e-6)
+      .add("evans_fung_thickness_centre_m", 0.810e-6)
+      .add("evans_fung_thickness_max_m", 2.566e-6)
+      .add("evans_fung_rho_of_thickness_max_m", 2.738e-6)
+      .add("evans_fung_reduced_volume", 0.644);
+  json.write(o.out + "/summary.json");
+  if (!o.quiet)
+    std::printf(
+        "deflate: %d nodes, V/V_sphere -> %.3f from a start squashed to %.2f: %d Newton steps; reduced "
+        "volume "
+        "%.3f, area %.4f of the sphere's, diameter %.2f um, thickness %.2f um at the centre, %.2f um at rho "
+        "= "
+        "%.2f um (%s); Evans-Fung: 7.82, 0.81, 2.57 at 2.74 um -> %s\n",
+        n, o.volume_fraction, o.squash, r.newton_steps, reduced, area / sphere_area, 2e6 * rho_max,
+        1e6 * t_centre, 1e6 * t_max, 1e6 * rho_at_max, t_centre < t_max ? "biconcave" : "not biconcave",
+        o.out.c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "deflate: the paper's biconcave start, a sphered cell deflated and relaxed (docs/VALIDATION.md)",
+      "deflate"};
+  Options o;
+  app.add_option("--nodes", o.nodes, "icosphere node count: 162, 642, 2562 or 10242 (default 642)");
+  app.add_option("--volume-fraction", o.volume_fraction,
+                 "target volume / sphere volume, 0.3 .. 1 (default 0.644)");
+  app.add_option("--squash", o.squash, "z scale of the start, 0.1 .. 1 (1: the sphere; default 0.45)");
+  app.add_option("--out", o.out, "output folder (default out/deflate)");
+  app.add_flag("--quiet", o.quiet, "print only errors");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    dcm::KokkosSession kokkos(0);
+    run(o);
+  } catch (const dcm::SceneError& e) {
+    std::cerr << "deflate: error: " << e.what() << '\n';
+    return 2;
+  } catch (const dcm::IoError& e) {
+    std::cerr << "deflate: error: " << e.what() << '\n';
+    return 2;
+  } catch (const dcm::NumericalError& e) {
+    std::cerr << "deflate: numerical failure: " << e.what() << '\n';
+    return 3;
+  }
+  return 0;
+}
