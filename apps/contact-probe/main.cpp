@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/common/app_cli.hpp"
 #include "apps/common/mechanics_setup.hpp"
 #include "core/checkpoint.hpp"
 #include "core/errors.hpp"
@@ -92,19 +93,8 @@ int main(int argc, char** argv) {
   app.add_option("CHECKPOINT", path, "checkpoint.h5 written by spread")->required();
   app.add_option("--set", sets, "KEY=VALUE: change a contact.*, geometry.*, cortex.E_Pa or cortex.nu key");
   app.add_flag("--all", all, "every triangle, also those without contact");
-  CLI11_PARSE(app, argc, argv);
-  try {
+  return dcm::run_app(app, argc, argv, [&] {
     dcm::KokkosSession kokkos(0);
     probe(path, sets, all);
-  } catch (const dcm::SceneError& e) {
-    std::cerr << "contact-probe: error: " << e.what() << '\n';
-    return 2;
-  } catch (const dcm::IoError& e) {
-    std::cerr << "contact-probe: error: " << e.what() << '\n';
-    return 2;
-  } catch (const dcm::NumericalError& e) {
-    std::cerr << "contact-probe: error: " << e.what() << '\n';
-    return 3;
-  }
-  return 0;
+  });
 }

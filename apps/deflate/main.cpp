@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/common/app_cli.hpp"
 #include "apps/common/mechanics_setup.hpp"
 #include "core/errors.hpp"
 #include "core/host_copy.hpp"
@@ -165,19 +166,8 @@ int main(int argc, char** argv) {
   app.add_option("--squash", o.squash, "z scale of the start, 0.1 .. 1 (1: the sphere; default 0.45)");
   app.add_option("--out", o.out, "output folder (default out/deflate)");
   app.add_flag("--quiet", o.quiet, "print only errors");
-  CLI11_PARSE(app, argc, argv);
-  try {
+  return dcm::run_app(app, argc, argv, [&] {
     dcm::KokkosSession kokkos(0);
     run(o);
-  } catch (const dcm::SceneError& e) {
-    std::cerr << "deflate: error: " << e.what() << '\n';
-    return 2;
-  } catch (const dcm::IoError& e) {
-    std::cerr << "deflate: error: " << e.what() << '\n';
-    return 2;
-  } catch (const dcm::NumericalError& e) {
-    std::cerr << "deflate: numerical failure: " << e.what() << '\n';
-    return 3;
-  }
-  return 0;
+  });
 }
