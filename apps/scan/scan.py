@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """scan: a parameter scan of spread runs (the paper's Figure 5 kind), described by a scan file.
 
-Stage 1 of issue 7 (docs/SCANS.md): every member is a spread run of its own, run by a pool of processes
-(--jobs at a time, each with --threads OpenMP threads); the batched engine and MPI are not done yet.
+Every member is a spread run of its own, run by a pool of processes (--jobs at a time, each with --threads OpenMP
+threads). Started by mpirun (mpirun -np P scan ...), the ranks share the members out (rank 0 hands them out one at
+a time), each rank runs its share with its own pool, and rank 0 writes the one set of outputs. The batched engine
+(many cells in one kernel launch) is not done (docs/SCANS.md).
 
   scan SCAN.toml [--out DIR] [--jobs N] [--threads T] [--dry-run] [--no-plot] [--quiet]
 
@@ -208,12 +210,133 @@ def plot(scan, out):
         print(f"{PROG}: warning: r_cc_grid.png not written: {r.stderr.strip().splitlines()[-1:]}", file=sys.stderr)
 
 
+# --- MPI (mpirun -np P scan ...): rank 0 hands out members one at a time (tag REQUEST -> MEMBER); every rank runs
+# its members with its own process pool; each rank reports its statuses (and, without a shared file system, its
+# members' files) with DONE; rank 0 alone writes summary.csv, scan.h5 and the plot. Ranks never write the same file.
+TAG_REQUEST, TAG_MEMBER, TAG_DONE = 11, 12, 13
+MEMBER_FILES_SKIPPED = {"checkpoint.h5"}  # what a rank without the shared file system does not send to rank 0
+
+
+def mpi_comm():
+    """MPI_COMM_WORLD when started by mpirun/mpiexec with more than one rank, else None."""
+    if not any(k in os.environ for k in ("OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK", "MPI_LOCALNRANKS")):
+        return None
+    try:
+        from mpi4py import MPI
+    except ImportError:
+        raise ScanError("started by mpirun, but this Python has no mpi4py (apt-get install python3-mpi4py)")
+    comm = MPI.COMM_WORLD
+    return comm if comm.Get_size() > 1 else None
+
+
+def ranks_on_this_machine(comm):
+    if comm is None:
+        return 1
+    from mpi4py import MPI
+    return comm.Split_type(MPI.COMM_TYPE_SHARED).Get_size()
+
+
+def prepare(a):
+    """Checks the arguments and every member's scene, writes scan.json; returns (scan, out). Raises ScanError."""
+    if a.jobs < 0 or a.jobs > 1024:
+        raise ScanError(f"--jobs = {a.jobs} is out of range: allowed 1 .. 1024 (0: the number of cores)")
+    if a.threads < 0 or a.threads > 1024:
+        raise ScanError(f"--threads = {a.threads} is out of range: allowed 1 .. 1024 (0: cores / members run at once)")
+    scan = load_scan(a.scan_file)
+    if a.dry_run:
+        return scan, None
+    for m in scan["members"]:  # every member's scene checked before anything is written
+        r = subprocess.run(spread_cmd(a.spread, scan, m, extra=["--check"]), capture_output=True, text=True)
+        if r.returncode != 0:
+            msg = (r.stderr.strip().splitlines() or ["spread --check failed"])[-1]
+            raise ScanError(f"member {m['id']} ({m['label']}): {msg}")
+    out = os.path.abspath(a.out or os.path.join("out", scan["name"]))
+    try:
+        os.makedirs(os.path.join(out, "members"), exist_ok=True)
+        with open(os.path.join(out, "scan.json.part"), "w") as f:
+            json.dump(scan, f, indent=1)
+        os.replace(os.path.join(out, "scan.json.part"), os.path.join(out, "scan.json"))
+    except OSError as e:
+        raise ScanError(f"--out {out}: cannot write there ({e.strerror})")
+    return scan, out
+
+
+def run_members(a, out, next_member, serve, jobs, threads, say):
+    """Runs members as spread processes, jobs at a time, until next_member() returns None or a signal arrives.
+    serve() is called while waiting (rank 0 answers the other ranks there). Returns ({id: status}, stopped)."""
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads), OMP_PROC_BIND="false")
+    for k in [k for k in env if k.startswith(("OMPI_", "PMIX_", "PMI_"))]:
+        del env[k]  # the members are plain programs, not MPI ranks
+    running, signalled, status = {}, set(), {}
+    stop = False
+    exhausted = False
+
+    def on_signal(sig, frame):
+        nonlocal stop
+        stop = True
+    signal.signal(signal.SIGINT, on_signal)
+    signal.signal(signal.SIGTERM, on_signal)
+    while (not exhausted and not stop) or running:
+        while not exhausted and not stop and len(running) < jobs:
+            m = next_member()
+            if m is None:
+                exhausted = True
+                break
+            mdir = os.path.join(out, "members", m["id"])
+            state = member_state(mdir, m)  # on this rank's file system
+            if state == "done":
+                status[m["id"]] = "done"
+                continue
+            if state == "resume":
+                cmd = [a.spread, "--restart", os.path.join(mdir, "checkpoint.h5"), "--quiet", "--no-plot"]
+            else:
+                shutil.rmtree(mdir, ignore_errors=True)
+                cmd = spread_cmd(a.spread, {"base": m["base"]}, m, mdir, ["--quiet", "--no-plot"])
+            os.makedirs(mdir, exist_ok=True)
+            with open(os.path.join(mdir, "member.json"), "w") as f:
+                json.dump({k: v for k, v in m.items() if k != "base"}, f, indent=1)
+            log = open(os.path.join(mdir, "spread.log"), "w")
+            running[m["id"]] = (subprocess.Popen(cmd, env=env, stdout=log, stderr=subprocess.STDOUT), m, time.time(), log)
+        serve(stop)
+        time.sleep(0.05)
+        for mid, (p, m, started, log) in list(running.items()):
+            rc = p.poll()
+            if rc is None:
+                continue
+            log.close()
+            del running[mid]
+            status[mid] = {0: "done", 3: "failed (numerical)", 130: "interrupted"}.get(rc, f"failed (exit {rc})")
+            say(f"{mid} {m['label']}: {status[mid]} in {time.time() - started:.1f} s")
+        if stop:  # each running member once: it writes its checkpoint and stops
+            for mid, (p, *_) in running.items():
+                if mid not in signalled and p.poll() is None:
+                    p.send_signal(signal.SIGINT)
+                    signalled.add(mid)
+    return status, stop
+
+
+def member_files(out, ids):
+    """{id: {file name: bytes}} of the members' outputs (for rank 0 when the ranks share no file system)."""
+    files = {}
+    for mid in ids:
+        mdir = os.path.join(out, "members", mid)
+        files[mid] = {}
+        for name in sorted(os.listdir(mdir)) if os.path.isdir(mdir) else []:
+            path = os.path.join(mdir, name)
+            if name not in MEMBER_FILES_SKIPPED and os.path.isfile(path):
+                with open(path, "rb") as f:
+                    files[mid][name] = f.read()
+    return files
+
+
 def main():
     ap = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0],
-                                 epilog="Scan files: scans/quick.toml, scans/figure5.toml; format in docs/SCANS.md.")
+                                 epilog="Scan files: scans/quick.toml, scans/figure5.toml; format in docs/SCANS.md. "
+                                        "Over several machines: mpirun -np P scan SCAN.toml (docs/SCANS.md).")
     ap.add_argument("scan_file", metavar="SCAN.toml")
     ap.add_argument("--out", help="output folder (default out/<scan name>)")
-    ap.add_argument("--jobs", type=int, default=0, help="members run at once (default: the number of cores)")
+    ap.add_argument("--jobs", type=int, default=0,
+                    help="members run at once (per MPI rank; default: the cores, shared among the ranks on a machine)")
     ap.add_argument("--threads", type=int, default=0,
                     help="OpenMP threads per member (default: cores / members run at once)")
     ap.add_argument("--dry-run", action="store_true", help="list the members and their --set arguments, run nothing")
@@ -222,103 +345,121 @@ def main():
     ap.add_argument("--spread", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "spread"),
                     help=argparse.SUPPRESS)
     a = ap.parse_args()
-    cores = os.cpu_count() or 1
     try:
-        if a.jobs < 0 or a.jobs > 1024:
-            raise ScanError(f"--jobs = {a.jobs} is out of range: allowed 1 .. 1024 (0: the number of cores)")
-        if a.threads < 0 or a.threads > 1024:
-            raise ScanError(f"--threads = {a.threads} is out of range: allowed 1 .. 1024 (0: cores / members run at once)")
-        scan = load_scan(a.scan_file)
-        jobs = a.jobs or cores
-        if a.dry_run:
-            for m in scan["members"]:
-                print(m["id"], m["label"], " ".join(f"--set {s}" for s in m["sets"]))
-            return 0
-        for m in scan["members"]:  # every member's scene checked before anything is written
-            r = subprocess.run(spread_cmd(a.spread, scan, m, extra=["--check"]), capture_output=True, text=True)
-            if r.returncode != 0:
-                msg = (r.stderr.strip().splitlines() or ["spread --check failed"])[-1]
-                raise ScanError(f"member {m['id']} ({m['label']}): {msg}")
-        out = a.out or os.path.join("out", scan["name"])
-        try:
-            os.makedirs(os.path.join(out, "members"), exist_ok=True)
-            with open(os.path.join(out, "scan.json.part"), "w") as f:
-                json.dump(scan, f, indent=1)
-            os.replace(os.path.join(out, "scan.json.part"), os.path.join(out, "scan.json"))
-        except OSError as e:
-            raise ScanError(f"--out {out}: cannot write there ({e.strerror})")
+        comm = mpi_comm()
     except ScanError as e:
         print(f"{PROG}: error: {e}", file=sys.stderr)
         return 2
+    rank = comm.Get_rank() if comm else 0
+    size = comm.Get_size() if comm else 1
 
-    status = {}
-    todo = []
-    for m in scan["members"]:
-        mdir = os.path.join(out, "members", m["id"])
-        state = member_state(mdir, m)
-        if state == "done":
-            status[m["id"]] = "done"
-        else:
-            todo.append((m, state))
-    # Fewer members to run than jobs: the cores go to the members as threads.
-    threads = a.threads or max(1, cores // max(1, min(jobs, len(todo))))
-    if not a.quiet:
-        print(f"{PROG}: {scan['name']}: {len(scan['members'])} members, {len(scan['members']) - len(todo)} already "
-              f"done; {jobs} at a time, {threads} thread(s) each -> {out}", flush=True)
-    env = dict(os.environ, OMP_NUM_THREADS=str(threads), OMP_PROC_BIND="false")
-    running = {}
-    signalled = set()
-    stop = False
+    # Rank 0 checks everything and creates the output folder; the others learn the outcome from it.
+    prepared = None
+    if rank == 0:
+        try:
+            prepared = prepare(a)
+        except ScanError as e:
+            print(f"{PROG}: error: {e}", file=sys.stderr)
+    if comm:
+        prepared = comm.bcast(prepared, root=0)
+    if prepared is None:
+        return 2
+    scan, out = prepared
+    if a.dry_run:
+        if rank == 0:
+            for m in scan["members"]:
+                print(m["id"], m["label"], " ".join(f"--set {s}" for s in m["sets"]))
+        return 0
+
+    cores = os.cpu_count() or 1
+    per_rank_cores = max(1, cores // ranks_on_this_machine(comm))
+    jobs = a.jobs or per_rank_cores
+    if rank > 0 and os.environ.get("DCM_SCAN_PRIVATE_DISKS") == "1":  # tests: as if each rank had its own disk
+        out = f"{out}.rank{rank}"
+    shared = os.path.isfile(os.path.join(out, "scan.json"))  # rank 0 wrote it before the broadcast
+    if not shared:
+        os.makedirs(os.path.join(out, "members"), exist_ok=True)
+    members = [dict(m, base=scan["base"]) for m in scan["members"]]
     t0 = time.time()
-    finished = 0
+    prefix = f"[rank {rank}] " if comm else ""
+    counter = [0]
 
-    def on_signal(sig, frame):
-        nonlocal stop
-        stop = True
-    signal.signal(signal.SIGINT, on_signal)
-    signal.signal(signal.SIGTERM, on_signal)
-    queue = list(todo)
-    while (queue and not stop) or running:
-        while queue and not stop and len(running) < jobs:
-            m, state = queue.pop(0)
-            mdir = os.path.join(out, "members", m["id"])
-            if state == "resume":
-                cmd = [a.spread, "--restart", os.path.join(mdir, "checkpoint.h5"), "--quiet", "--no-plot"]
-            else:
-                shutil.rmtree(mdir, ignore_errors=True)
-                cmd = spread_cmd(a.spread, scan, m, mdir, ["--quiet", "--no-plot"])
-            os.makedirs(mdir, exist_ok=True)
-            with open(os.path.join(mdir, "member.json"), "w") as f:
-                json.dump(m, f, indent=1)
-            log = open(os.path.join(mdir, "spread.log"), "w")
-            running[m["id"]] = (subprocess.Popen(cmd, env=env, stdout=log, stderr=subprocess.STDOUT), m, time.time(), log)
-        time.sleep(0.05)
-        for mid, (p, m, started, log) in list(running.items()):
-            rc = p.poll()
-            if rc is None:
-                continue
-            log.close()
-            del running[mid]
-            finished += 1
-            status[mid] = {0: "done", 3: "failed (numerical)", 130: "interrupted"}.get(rc, f"failed (exit {rc})")
-            if not a.quiet:
-                print(f"[{finished}/{len(todo)}] {mid} {m['label']}: {status[mid]} in {time.time() - started:.1f} s",
-                      flush=True)
-        if stop:  # each running member once: it writes its checkpoint and stops
-            for mid, (p, *_) in running.items():
-                if mid not in signalled and p.poll() is None:
-                    p.send_signal(signal.SIGINT)
-                    signalled.add(mid)
-    rows = collect(scan, out, status)
-    write_h5(scan, out, rows)
-    if not a.no_plot and not stop:
-        plot(scan, out)
-    if not a.quiet:
-        print(f"{PROG}: wrote {out}/summary.csv, {out}/scan.h5 ({time.time() - t0:.1f} s)", flush=True)
-    if stop:
-        print(f"{PROG}: stopped; run the same command again to finish the missing members", file=sys.stderr)
-        return 130
-    return 3 if any(s.startswith("failed") for s in status.values()) else 0
+    if rank == 0:
+        queue = [m for m in members if member_state(os.path.join(out, "members", m["id"]), m) != "done"]
+        n_todo = len(queue)
+        status = {m["id"]: "done" for m in members if all(m["id"] != q["id"] for q in queue)}
+        threads = a.threads or max(1, per_rank_cores // max(1, min(jobs, n_todo)))
+        if not a.quiet:
+            where = f"; {size} MPI ranks" if comm else ""
+            print(f"{PROG}: {scan['name']}: {len(members)} members, {len(members) - n_todo} already done; {jobs} at a "
+                  f"time, {threads} thread(s) each{where} -> {out}", flush=True)
+        done_ranks, remote = set(), {}
+        handed = {"stop": False}
+
+        def next_local():
+            return queue.pop(0) if queue and not handed["stop"] else None
+
+        def serve(stop):
+            handed["stop"] = handed["stop"] or stop
+            if not comm:
+                return
+            from mpi4py import MPI
+            st = MPI.Status()
+            while comm.Iprobe(source=MPI.ANY_SOURCE, tag=MPI.ANY_TAG, status=st):
+                src, tag = st.Get_source(), st.Get_tag()
+                msg = comm.recv(source=src, tag=tag)
+                if tag == TAG_REQUEST:
+                    comm.send(next_local(), dest=src, tag=TAG_MEMBER)
+                elif tag == TAG_DONE:
+                    done_ranks.add(src)
+                    remote.update(msg["status"])
+                    for mid, files in msg["files"].items():
+                        mdir = os.path.join(out, "members", mid)
+                        os.makedirs(mdir, exist_ok=True)
+                        for name, data in files.items():
+                            with open(os.path.join(mdir, name), "wb") as f:
+                                f.write(data)
+
+        def say(text):
+            counter[0] += 1
+            if not a.quiet:  # under MPI each rank reports its own members
+                print(f"{prefix}{text}" if comm else f"[{counter[0]}/{n_todo}] {text}", flush=True)
+
+        local, stop = run_members(a, out, next_local, serve, jobs, threads, say)
+        while comm and len(done_ranks) < size - 1:  # the others finish their members; keep answering them
+            serve(stop)
+            time.sleep(0.05)
+        status.update(local)
+        status.update(remote)
+        stop = stop or any(s == "interrupted" for s in status.values())
+        rows = collect(scan, out, status)
+        write_h5(scan, out, rows)
+        if not a.no_plot and not stop:
+            plot(scan, out)
+        if not a.quiet:
+            print(f"{PROG}: wrote {out}/summary.csv, {out}/scan.h5 ({time.time() - t0:.1f} s)", flush=True)
+        if stop:
+            print(f"{PROG}: stopped; run the same command again to finish the missing members", file=sys.stderr)
+            rc = 130
+        else:
+            rc = 3 if any(s.startswith("failed") for s in status.values()) else 0
+        return comm.bcast(rc, root=0) if comm else rc
+
+    # Ranks 1 .. P-1: ask rank 0 for one member at a time.
+    threads = a.threads or max(1, per_rank_cores // jobs)
+
+    def next_remote():
+        comm.send(None, dest=0, tag=TAG_REQUEST)
+        return comm.recv(source=0, tag=TAG_MEMBER)
+
+    def say(text):
+        if not a.quiet:
+            print(f"{prefix}{text}", flush=True)
+
+    local, stop = run_members(a, out, next_remote, lambda stop: None, jobs, threads, say)
+    files = {} if shared else member_files(out, local)
+    comm.send({"status": local, "files": files}, dest=0, tag=TAG_DONE)
+    return comm.bcast(None, root=0)
 
 
 if __name__ == "__main__":
