@@ -65,6 +65,10 @@ def main():
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--spread", default=os.path.join(ROOT, "build/bin/spread"))
     ap.add_argument("--per-decade", type=int, default=400, help="series rows per decade of time")
+    ap.add_argument("--only", default="", help="comma-separated run names to do (default: all; reference is always run)")
+    ap.add_argument("--variants-adaptive", default="",
+                    help="run the quadrature and CG-tolerance cases with adaptive steps at this tolerance (m) "
+                         "instead of the paper's fixed dt (long scenes)")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     dt = a.dt
@@ -74,12 +78,21 @@ def main():
     for tol in ("1e-8", "3e-9", "1e-9"):
         cases.append((f"adaptive_{tol}", "adaptive", ["time.adaptive=true", f"time.error_tol_m={tol}",
                                                        f"time.dt_s={dt}"]))
+    if a.variants_adaptive:
+        base, how = ["time.adaptive=true", f"time.error_tol_m={a.variants_adaptive}", f"time.dt_s={dt}"], \
+            f"adaptive {a.variants_adaptive}"
+    else:
+        base, how = [f"time.dt_s={dt}"], "paper dt"
     for q in (1, 3, 7, 16):
-        cases.append((f"quadrature_{q}", "quadrature (paper dt)", [f"contact.quadrature_points={q}",
-                                                                    f"time.dt_s={dt}"]))
+        cases.append((f"quadrature_{q}", f"quadrature ({how})", [f"contact.quadrature_points={q}"] + base))
     for tol in ("1e-12", "1e-10"):
-        cases.append((f"cg_abs_tol_{tol}", "CG tolerance (paper dt)", [f"solver.cg_abs_tol_N={tol}",
-                                                                        f"time.dt_s={dt}"]))
+        cases.append((f"cg_abs_tol_{tol}", f"CG tolerance ({how})", [f"solver.cg_abs_tol_N={tol}"] + base))
+    if a.only:
+        keep = set(a.only.split(",")) | {"reference"}
+        unknown = keep - {c[0] for c in cases}
+        if unknown:
+            sys.exit(f"work_precision: --only: unknown run '{sorted(unknown)[0]}' (runs: {', '.join(c[0] for c in cases)})")
+        cases = [c for c in cases if c[0] in keep]
     results, failed = {}, {}
     for name, family, sets in cases:
         print(f"== {name}: {' '.join(sets)}", flush=True)
@@ -124,13 +137,14 @@ def main():
         print("work_precision: matplotlib missing, no PNG", file=sys.stderr)
         return
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.6))
-    markers = {"fixed dt": "o-", "adaptive": "s-", "quadrature (paper dt)": "^", "CG tolerance (paper dt)": "v"}
+    markers = {"fixed dt": "o-", "adaptive": "s-", "quadrature": "^", "CG tolerance": "v"}
     for ax, key, start in ((axes[0], "max_rel_error_r_cc", a.from_s), (axes[1], "max_rel_error_r_cc_late", a.late_from_s)):
         for family, style in markers.items():
-            pts = [(r["wall_s"], max(r[key], 1e-6), r["run"]) for r in table if r["family"] == family]
+            pts = [(r["wall_s"], max(r[key], 1e-6), r["run"]) for r in table if r["family"].split(" (")[0] == family]
             if not pts:
                 continue
-            ax.plot([p[0] for p in pts], [p[1] for p in pts], style, label=family)
+            label = next(r["family"] for r in table if r["family"].split(" (")[0] == family)
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], style, label=label)
             for x, y, n in pts:
                 ax.annotate(n.replace("fixed_dt_", "").replace("adaptive_", "").replace("quadrature_", "q")
                             .replace("cg_abs_tol_", "cg "), (x, y), fontsize=7, textcoords="offset points",

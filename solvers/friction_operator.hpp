@@ -152,7 +152,7 @@ struct SubstrateBlocks {
   View<double*> area;
 
   KOKKOS_INLINE_FUNCTION void add_block(int i, int j, double blk[6]) const {
-    if (!on) return;
+    if (!on || (lumped && i != j)) return;  // lumped: diagonal blocks only
     for (int q = tri_offsets(i); q < tri_offsets(i + 1); ++q) {
       const int t = corners(q) / 3;
       const double a = area(t);

@@ -62,6 +62,9 @@ struct Multigrid {
   MultigridSettings settings;
   int n_cells = 0;
   View<int*> fine_slot_bond;  // level 0: the bond of each off-diagonal slot, −1 on the diagonal
+  // Level 0: per slot (i, j) the triangle corners (t, c_i, c_j) with tri(t, c_i) = i, tri(t, c_j) = j, packed
+  // as 9 t + 3 c_i + c_j, in the order of i's triangle corners (the implicit tension blocks; topology only).
+  View<int*> fine_slot_tension_offsets, fine_slot_tension;
   std::vector<MultigridLevel<MemorySpace>> levels;
   View<double***> coarse_inverse;  // per cell, the inverse of the coarsest operator (36 × 36)
   typename View<double***>::host_mirror_type coarse_inverse_host;
@@ -175,6 +178,25 @@ Multigrid<MemorySpace> make_multigrid(const std::vector<HostCell>& cells,
       lv.restrict_weight = mg_detail::upload_vector<DV>("restrict_weight", t.restrict_weight);
     }
   }
+  {  // the triangle corners of each fine slot, for the implicit tension blocks
+    const auto tri = to_host_vector(mesh.tri);
+    const auto tri_off = to_host_vector(mesh.node_tri_offsets),
+               corners = to_host_vector(mesh.node_tri_corners);
+    const std::vector<int>& row_off = h.fine.offsets;
+    const std::vector<int>& cols = h.fine.cols;
+    std::vector<int> offsets(1, 0), entries;
+    for (int i = 0; i + 1 < static_cast<int>(row_off.size()); ++i)
+      for (int sl = row_off[i]; sl < row_off[i + 1]; ++sl) {
+        for (int q = tri_off[i]; q < tri_off[i + 1]; ++q) {
+          const int t = corners[q] / 3, ci = corners[q] % 3;
+          for (int cj = 0; cj < 3; ++cj)
+            if (tri[3 * t + cj] == cols[sl]) entries.push_back(9 * t + 3 * ci + cj);
+        }
+        offsets.push_back(static_cast<int>(entries.size()));
+      }
+    mg.fine_slot_tension_offsets = mg_detail::upload_vector<IV>("fine_slot_tension_offsets", offsets);
+    mg.fine_slot_tension = mg_detail::upload_vector<IV>("fine_slot_tension", entries);
+  }
   if (h.available) {
     mg.coarse_inverse = typename M::template View<double***>("dcm::mg::coarse_inverse", mg.n_cells,
                                                              M::kCoarseDofs, M::kCoarseDofs);
@@ -209,9 +231,8 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
     const bool with_tension = tension != nullptr;
     const auto t_edge = with_tension ? tension->edge : decltype(tension->edge)();
     const auto t_normal = with_tension ? tension->normal : decltype(tension->normal)();
-    const auto tri = mesh.tri;
-    const auto tri_offsets = mesh.node_tri_offsets;
-    const auto tri_corners = mesh.node_tri_corners;
+    const auto slot_t_off = mg.fine_slot_tension_offsets;
+    const auto slot_t = mg.fine_slot_tension;
     Kokkos::parallel_for(
         "dcm::mg::assemble_fine", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows),
         KOKKOS_LAMBDA(const int i) {
@@ -227,14 +248,11 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
             }
             substrate.add_block(i, cols(s), blk);
             if (with_tension)
-              for (int q = tri_offsets(i); q < tri_offsets(i + 1); ++q) {
-                const int t = tri_corners(q) / 3, ci = tri_corners(q) % 3;
-                for (int cj = 0; cj < 3; ++cj) {
-                  if (tri(t, cj) != cols(s)) continue;
-                  const double w = t_edge(t, ci, 0) * t_edge(t, cj, 0) + t_edge(t, ci, 1) * t_edge(t, cj, 1) +
-                                   t_edge(t, ci, 2) * t_edge(t, cj, 2);
-                  add_dashpot_block(load3(t_normal, t), w, 0.0, 1.0, blk);  // w n_t n_tᵀ
-                }
+              for (int q = slot_t_off(s); q < slot_t_off(s + 1); ++q) {
+                const int t = slot_t(q) / 9, ci = slot_t(q) / 3 % 3, cj = slot_t(q) % 3;
+                const double w = t_edge(t, ci, 0) * t_edge(t, cj, 0) + t_edge(t, ci, 1) * t_edge(t, cj, 1) +
+                                 t_edge(t, ci, 2) * t_edge(t, cj, 2);
+                add_dashpot_block(load3(t_normal, t), w, 0.0, 1.0, blk);  // w n_t n_tᵀ
               }
             for (int k = 0; k < 6; ++k) val(s, k) = blk[k];
           }
