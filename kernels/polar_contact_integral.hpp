@@ -23,55 +23,93 @@ KOKKOS_INLINE_FUNCTION void gauss_legendre8(int i, double& x, double& w) {
   w = ws[k];
 }
 
-// G(ρ) = ∫_0^ρ p(r) r dr (N/m... i.e. Pa·m²): the load inside radius ρ is 2π G(ρ).
-KOKKOS_INLINE_FUNCTION double md_radial_load(const MdState& st, double rho) {
-  double g = 0;
-  const double a = st.a;
-  if (a > 0) {
-    const double r = math::min(rho, a);
-    const double u = math::sqrt(math::max(a * a - r * r, 0.0));
-    g += st.p0 / (3.0 * a) * (a * a * a - u * u * u);  // Hertz (eq. 5)
-    const double w = math::sqrt(math::max(st.c * st.c - a * a, 0.0));
-    if (st.sigma0 > 0 && w > 0) {  // Dugdale inside a (eq. 7): −(2σ0/π) atan(w / sqrt(a² − r²))
-      auto F = [&](double v) {
-        return 0.5 * v * v * math::atan2(w, v) + 0.5 * w * v - 0.5 * w * w * math::atan2(v, w);
-      };
-      g -= 2.0 / kMdPi * st.sigma0 * (F(a) - F(u));
+// The radial integrals of the MD pressure about the contact centre,
+//   G(ρ) = ∫_0^ρ p(r) r dr (Pa·m²; the load inside radius ρ is 2π G(ρ)),   H(ρ) = ∫_0^ρ p(r) r² dr (Pa·m³),
+// in closed form. Inside the contact radius (ρ < a) with r = a sin φ, u = sqrt(a² − r²) = a cos φ, k = w/a,
+// w = sqrt(c² − a²):
+//   Hertz (eq. 5):      G = p0/(3a) (a³ − u³),   H = (p0/a) [r (2r² − a²) u + a⁴ φ] / 8;
+//   Dugdale (eq. 7), p = −(2σ0/π) atan(w/u):  G −= (2σ0/π) (F(a) − F(u)),  F(v) = ½(v² + w²) atan2(w, v) +
+//   ½wv − (π/4)w²,
+//     H −= (2σ0/π) a³ [sin³φ/3 · atan2(k, cos φ) − k J(φ)/3],
+//     J(φ) = φ/2 + sin 2φ/4 − (2 + k²) φ + (1 + k²)^{3/2}/k · atan(k tan φ / sqrt(1 + k²));
+// outside it, −σ0 on a < r < c. MdRadial keeps what depends on the triangle only (w, F(a), G(a), H(a)), so a
+// point with ρ ≥ a costs no transcendental function and one inside a costs three atan2 (φ = atan2(r, u), sin
+// φ = r/a and cos φ = u/a exactly, atan2(k, cos φ) = atan2(w, u)).
+struct MdRadial {
+  double a = 0, c = 0, p0 = 0, sigma0 = 0;
+  double w = 0, k = 0, q = 0, Fa = 0;  // w = sqrt(c² − a²), k = w/a, q = sqrt(1 + k²), F(a)
+  double Ga = 0, Ha = 0;               // G(a), H(a)
+  bool dugdale_inside = false;         // σ0 > 0 and c > a: the Dugdale stress reaches inside a
+};
+
+namespace detail {
+// G(ρ), H(ρ) for ρ < a (a > 0).
+KOKKOS_INLINE_FUNCTION void md_radial_inside(const MdRadial& m, double rho, double& g, double& h) {
+  const double a = m.a;
+  const double r = math::min(rho, a);
+  const double u = math::sqrt(math::max(a * a - r * r, 0.0));
+  const double phi = math::atan2(r, u);  // asin(r/a)
+  g = m.p0 / (3.0 * a) * (a * a * a - u * u * u);
+  h = m.p0 / a * (r * (2 * r * r - a * a) * u + a * a * a * a * phi) / 8.0;
+  if (m.dugdale_inside) {
+    const double w = m.w;
+    const double t = math::atan2(w, u);  // = atan2(k, cos φ)
+    const double Fu = 0.5 * (u * u + w * w) * t + 0.5 * w * u - 0.25 * kMdPi * w * w;
+    g -= 2.0 / kMdPi * m.sigma0 * (m.Fa - Fu);
+    if (phi > 0) {
+      const double k = m.k, q = m.q, sn = r / a, cs = u / a;
+      const double kj =
+          k * (phi / 2 + sn * cs / 2 - (2 + k * k) * phi) + q * q * q * math::atan2(k * sn, q * cs);
+      const double d = a * a * a * (sn * sn * sn / 3 * t - kj / 3);
+      h -= 2.0 / kMdPi * m.sigma0 * d;
     }
   }
-  if (rho > a && st.c > a) {  // −σ0 on a < r < c
-    const double r = math::min(rho, st.c);
-    g -= 0.5 * st.sigma0 * (r * r - a * a);
+}
+}  // namespace detail
+
+KOKKOS_INLINE_FUNCTION MdRadial md_radial(const MdState& st) {
+  MdRadial m;
+  m.a = st.a;
+  m.c = st.c;
+  m.p0 = st.p0;
+  m.sigma0 = st.sigma0;
+  if (!(st.a > 0)) return m;
+  m.w = math::sqrt(math::max(st.c * st.c - st.a * st.a, 0.0));
+  m.dugdale_inside = st.sigma0 > 0 && m.w > 0;
+  m.k = m.w / st.a;
+  m.q = math::sqrt(1 + m.k * m.k);
+  m.Fa =
+      0.5 * (st.a * st.a + m.w * m.w) * math::atan2(m.w, st.a) + 0.5 * m.w * st.a - 0.25 * kMdPi * m.w * m.w;
+  detail::md_radial_inside(m, st.a, m.Ga, m.Ha);
+  return m;
+}
+
+// G(ρ) and H(ρ) (see MdRadial).
+KOKKOS_INLINE_FUNCTION void md_radial_integrals(const MdRadial& m, double rho, double& g, double& h) {
+  if (m.a > 0 && rho < m.a) {
+    detail::md_radial_inside(m, rho, g, h);
+    return;
   }
+  g = m.Ga;
+  h = m.Ha;
+  if (rho > m.a && m.c > m.a) {  // −σ0 on a < r < c
+    const double r = math::min(rho, m.c);
+    g -= 0.5 * m.sigma0 * (r * r - m.a * m.a);
+    h -= m.sigma0 * (r * r * r - m.a * m.a * m.a) / 3.0;
+  }
+}
+
+// G(ρ) = ∫_0^ρ p(r) r dr (Pa·m²): the load inside radius ρ is 2π G(ρ).
+KOKKOS_INLINE_FUNCTION double md_radial_load(const MdState& st, double rho) {
+  double g, h;
+  md_radial_integrals(md_radial(st), rho, g, h);
   return g;
 }
 
 // H(ρ) = ∫_0^ρ p(r) r² dr (Pa·m³).
 KOKKOS_INLINE_FUNCTION double md_radial_moment(const MdState& st, double rho) {
-  double h = 0;
-  const double a = st.a;
-  if (a > 0) {
-    const double r = math::min(rho, a);
-    const double u = math::sqrt(math::max(a * a - r * r, 0.0));
-    const double phi_end = math::asin(math::min(r / a, 1.0));
-    // Hertz: (p0/a) ∫ r² sqrt(a² − r²) dr
-    h += st.p0 / a * (r * (2 * r * r - a * a) * u + a * a * a * a * phi_end) / 8.0;
-    const double w = math::sqrt(math::max(st.c * st.c - a * a, 0.0));
-    if (st.sigma0 > 0 && w > 0 && phi_end > 0) {
-      // Dugdale inside a: ∫_0^ρ r² atan(w / sqrt(a² − r²)) dr with r = a sin φ, k = w/a, by parts:
-      //   a³ [sin³Φ/3 · atan(k / cos Φ) − (k/3) J(Φ)],  J = ∫ sin⁴φ / (cos²φ + k²) dφ
-      //   J(Φ) = Φ/2 + sin 2Φ/4 − (2 + k²) Φ + (1 + k²)^{3/2}/k · atan(k tan Φ / sqrt(1 + k²)).
-      const double k = w / a, sn = math::sin(phi_end), cs = math::cos(phi_end), q = math::sqrt(1 + k * k);
-      const double kj = k * (phi_end / 2 + sn * cs / 2 - (2 + k * k) * phi_end) +
-                        q * q * q * math::atan2(k * sn, q * cs);  // k · J(Φ)
-      const double d = a * a * a * (sn * sn * sn / 3 * math::atan2(k, cs) - kj / 3);
-      h -= 2.0 / kMdPi * st.sigma0 * d;
-    }
-  }
-  if (rho > a && st.c > a) {
-    const double r = math::min(rho, st.c);
-    h -= st.sigma0 * (r * r * r - a * a * a) / 3.0;
-  }
+  double g, h;
+  md_radial_integrals(md_radial(st), rho, g, h);
   return h;
 }
 
@@ -88,7 +126,7 @@ namespace detail {
 // κ = F × d̂ (= ±h). The integrands G(ρ) κ/ρ², H(ρ) κ/ρ³ (sin θ, cos θ) stay bounded and smooth even when C
 // lies on or near the edge's line (where an angle parametrisation is nearly singular); pieces split where
 // ρ = a and ρ = c, 8-point Gauss–Legendre on each.
-KOKKOS_INLINE_FUNCTION void polar_sector(const MdState& st, double px, double py, double qx, double qy,
+KOKKOS_INLINE_FUNCTION void polar_sector(const MdRadial& st, double px, double py, double qx, double qy,
                                          PolarIntegral& out) {
   const double dx = qx - px, dy = qy - py, len = math::sqrt(dx * dx + dy * dy);
   if (!(len > 0)) return;
@@ -128,8 +166,10 @@ KOKKOS_INLINE_FUNCTION void polar_sector(const MdState& st, double px, double py
       const double rx = fx + sv * ux, ry = fy + sv * uy;
       const double rho2 = h2 + sv * sv, rho = math::sqrt(rho2);
       const double dtheta = wt * half * kappa / rho2;
-      const double hm = md_radial_moment(st, rho) / rho;
-      out.load += dtheta * md_radial_load(st, rho);
+      double g, hr;
+      md_radial_integrals(st, rho, g, hr);
+      const double hm = hr / rho;
+      out.load += dtheta * g;
       out.m1 += dtheta * hm * ry;  // ê × n = sin θ e1 − cos θ e2
       out.m2 -= dtheta * hm * rx;
       const double ra = math::min(rho, st.a);
@@ -152,7 +192,8 @@ KOKKOS_INLINE_FUNCTION PolarIntegral polar_contact_integral(const MdState& st, R
     qy[k] = dot(xs[k] - C, e2);
   }
   PolarIntegral out;
-  for (int k = 0; k < 3; ++k) detail::polar_sector(st, qx[k], qy[k], qx[(k + 1) % 3], qy[(k + 1) % 3], out);
+  const MdRadial m = md_radial(st);
+  for (int k = 0; k < 3; ++k) detail::polar_sector(m, qx[k], qy[k], qx[(k + 1) % 3], qy[(k + 1) % 3], out);
   const double orientation = (qx[1] - qx[0]) * (qy[2] - qy[0]) - (qy[1] - qy[0]) * (qx[2] - qx[0]);
   if (orientation < 0) {
     out.load = -out.load;

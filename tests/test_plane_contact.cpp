@@ -179,6 +179,55 @@ TEST(PlaneContact, RadialIntegralsMatchNumericalIntegration) {
   }
 }
 
+// The kernel's G and H (shared transcendental terms, precomputed per triangle) against the closed forms
+// written out directly (asin, sin, cos, four atan2 per point), to rounding: the rewrite changes cost only.
+TEST(PlaneContact, RadialIntegralsMatchTheDirectClosedForms) {
+  auto direct = [](const MdState& st, double rho, double& g, double& h) {
+    g = h = 0;
+    const double a = st.a;
+    if (a > 0) {
+      const double r = std::fmin(rho, a), u = std::sqrt(std::fmax(a * a - r * r, 0.0));
+      const double w = std::sqrt(std::fmax(st.c * st.c - a * a, 0.0));
+      g += st.p0 / (3 * a) * (a * a * a - u * u * u);
+      const double phi = std::asin(std::fmin(r / a, 1.0));
+      h += st.p0 / a * (r * (2 * r * r - a * a) * u + a * a * a * a * phi) / 8;
+      if (st.sigma0 > 0 && w > 0) {
+        auto F = [&](double v) {
+          return 0.5 * v * v * std::atan2(w, v) + 0.5 * w * v - 0.5 * w * w * std::atan2(v, w);
+        };
+        g -= 2 / kMdPi * st.sigma0 * (F(a) - F(u));
+        if (phi > 0) {
+          const double k = w / a, sn = std::sin(phi), cs = std::cos(phi), q = std::sqrt(1 + k * k);
+          const double kj =
+              k * (phi / 2 + sn * cs / 2 - (2 + k * k) * phi) + q * q * q * std::atan2(k * sn, q * cs);
+          h -= 2 / kMdPi * st.sigma0 * a * a * a * (sn * sn * sn / 3 * std::atan2(k, cs) - kj / 3);
+        }
+      }
+    }
+    if (rho > a && st.c > a) {
+      const double r = std::fmin(rho, st.c);
+      g -= 0.5 * st.sigma0 * (r * r - a * a);
+      h -= st.sigma0 * (r * r * r - a * a * a) / 3;
+    }
+  };
+  for (double lambda : {0.1, 1.0, 10.0, 100.0})
+    for (double a : {0.0, 1e-9, 0.4e-6}) {
+      MdState st = md_state_from_radius(a, kR, material_for_lambda(lambda));
+      if (a == 0) st.c = 0.2e-6;  // the gap branch: an adhesive disc only
+      const double scale_g = st.p0 * st.a * st.a + st.sigma0 * st.c * st.c;
+      const double scale_h = scale_g * std::fmax(st.a, st.c);
+      for (double f : {0.0, 1e-6, 0.1, 0.5, 0.9, 0.999999, 1.0, 1.000001, 1.3}) {
+        for (double rho : {f * st.a, st.a + f * (st.c - st.a), 1.5 * st.c}) {
+          double g, h;
+          direct(st, rho, g, h);
+          EXPECT_NEAR(md_radial_load(st, rho), g, 1e-13 * scale_g) << lambda << " a " << a << " rho " << rho;
+          EXPECT_NEAR(md_radial_moment(st, rho), h, 1e-13 * scale_h)
+              << lambda << " a " << a << " rho " << rho;
+        }
+      }
+    }
+}
+
 // Reference integral of the MD pressure over a flat triangle in the plane z = 0 around C = 0: the triangle
 // split into 4^L sub-triangles, each by the 16-point rule.
 void reference_integral(const MdState& st, Real3 p0, Real3 p1, Real3 p2, int level, double& F, Real3& M) {
