@@ -22,8 +22,9 @@
 // The four forces sum to zero and have zero torque (theta is invariant under rigid motions). A
 // degenerate hinge (a zero-area triangle or a zero-length edge) contributes no force.
 //
-// Two ways to gather: add_bending_forces() evaluates every hinge once into a scratch array owned by
-// HingeRest (hinge_force[h][role][3]) and then gathers per node over the node -> (hinge, role) CSR list;
+// Two ways to gather: add_bending_forces() evaluates every hinge once into arrays owned by HingeRest (the
+// gradient of theta per role, the factor -M and cos(theta - theta*); solvers/bending_stiffness.hpp reuses
+// them for the implicit step) and then gathers per node over the node -> (hinge, role) CSR list;
 // add_bending_forces_per_node() recomputes each hinge at each of its four nodes (no scratch). Both are
 // deterministic (no atomics). On the CPU the hinge pass is faster (docs/model/bonds_bending.md).
 //
@@ -38,11 +39,13 @@
 
 namespace dcm {
 
-// Rest state of the hinges and the scratch space of the hinge pass (allocated once).
+// Rest state of the hinges and what the hinge pass of add_bending_forces() leaves (allocated once).
 template <class MemorySpace>
 struct HingeRest {
-  Kokkos::View<double* [2], Kokkos::LayoutRight, MemorySpace> rest_trig;       // (cos theta*, sin theta*)
-  Kokkos::View<double* [4][3], Kokkos::LayoutRight, MemorySpace> hinge_force;  // scratch (N)
+  Kokkos::View<double* [2], Kokkos::LayoutRight, MemorySpace> rest_trig;      // (cos theta*, sin theta*)
+  Kokkos::View<double* [4][3], Kokkos::LayoutRight, MemorySpace> hinge_grad;  // dtheta/dx per role (1/m)
+  Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> hinge_moment;       // -k_b sin(theta - theta*) (J)
+  Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> hinge_cos_delta;    // cos(theta - theta*)
 };
 
 // Signed hinge angle theta (rad).
@@ -93,8 +96,9 @@ HingeRest<MemorySpace> make_hinge_rest(const ExecutionSpace& space, const MeshBu
   HingeRest<MemorySpace> rest;
   rest.rest_trig = decltype(rest.rest_trig)(
       Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::bending::rest_trig"), mesh.n_hinges);
-  rest.hinge_force = decltype(rest.hinge_force)(
-      Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::bending::hinge_force"), mesh.n_hinges);
+  rest.hinge_grad = decltype(rest.hinge_grad)("dcm::bending::hinge_grad", mesh.n_hinges);
+  rest.hinge_moment = decltype(rest.hinge_moment)("dcm::bending::hinge_moment", mesh.n_hinges);
+  rest.hinge_cos_delta = decltype(rest.hinge_cos_delta)("dcm::bending::hinge_cos_delta", mesh.n_hinges);
   const auto x = mesh.x;
   const auto hinge = mesh.hinge;
   const auto rest_trig = rest.rest_trig;
@@ -132,8 +136,8 @@ void set_hinge_rest_angles(const HingeRest<MemorySpace>& rest, const std::vector
   Kokkos::deep_copy(rest.rest_trig, h);
 }
 
-// force(i) += bending forces on node i: one pass over the hinges into rest.hinge_force, then a gather
-// over the node's CSR (hinge, role) list (no atomics).
+// force(i) += bending forces on node i: one pass over the hinges (gradient, -M and cos(theta - theta*) into
+// rest), then a gather over the node's CSR (hinge, role) list of F_a = -M dtheta/dx_a (no atomics).
 template <class ExecutionSpace, class MemorySpace>
 void add_bending_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                         const HingeRest<MemorySpace>& rest, double k_b,
@@ -141,17 +145,23 @@ void add_bending_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpa
   const auto x = mesh.x;
   const auto hinge = mesh.hinge;
   const auto rest_trig = rest.rest_trig;
-  const auto hinge_force = rest.hinge_force;
+  const auto grad = rest.hinge_grad;
+  const auto moment = rest.hinge_moment;
+  const auto cos_delta = rest.hinge_cos_delta;
   Kokkos::parallel_for(
       "dcm::bending::hinges", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_hinges),
       KOKKOS_LAMBDA(const int h) {
-        Real3 f[4];
-        hinge_bending_forces(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
-                             load3(x, hinge(h, 3)), rest_trig(h, 0), rest_trig(h, 1), k_b, f);
+        double c, s;
+        Real3 g[4];
+        hinge_trig_gradient(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
+                            load3(x, hinge(h, 3)), c, s, g);
+        const double cr = rest_trig(h, 0), sr = rest_trig(h, 1);
+        moment(h) = -k_b * (s * cr - c * sr);  // -M = -k_b sin(theta - theta*), eq. 26
+        cos_delta(h) = c * cr + s * sr;
         for (int a = 0; a < 4; ++a) {
-          hinge_force(h, a, 0) = f[a].x;
-          hinge_force(h, a, 1) = f[a].y;
-          hinge_force(h, a, 2) = f[a].z;
+          grad(h, a, 0) = g[a].x;
+          grad(h, a, 1) = g[a].y;
+          grad(h, a, 2) = g[a].z;
         }
       });
   const auto offsets = mesh.node_hinge_offsets;
@@ -162,9 +172,10 @@ void add_bending_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpa
         double f0 = 0, f1 = 0, f2 = 0;
         for (int s = offsets(i); s < offsets(i + 1); ++s) {
           const int h = roles(s) / 4, a = roles(s) % 4;
-          f0 += hinge_force(h, a, 0);
-          f1 += hinge_force(h, a, 1);
-          f2 += hinge_force(h, a, 2);
+          const double m = moment(h);
+          f0 += m * grad(h, a, 0);
+          f1 += m * grad(h, a, 1);
+          f2 += m * grad(h, a, 2);
         }
         force(i, 0) += f0;
         force(i, 1) += f1;

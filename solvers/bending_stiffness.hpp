@@ -4,55 +4,40 @@
 // the paper's Δt (forward Euler is unstable at 2562 nodes). Adding the Gauss–Newton part of the bending
 // Hessian, Δt Σ_h k_b max(cos(θ_h − θ*_h), 0) ∇θ_h ∇θ_hᵀ (positive semi-definite), to the friction operator
 // makes the step (Γ + Δt K_bend) v = F implicit in exactly these modes. Applied matrix-free: a hinge pass
-// (s_h = g_h · v) and a gather over the node's hinges (no atomics), with g_h = sqrt(Δt k_b max(cos, 0)) ∇θ_h
-// cached once per step.
+// (s_h = Δt k_b max(cos, 0) ∇θ_h · v) and a gather over the node's hinges (no atomics). ∇θ_h and cos(θ_h −
+// θ*_h) are those the bending force pass of the same positions left in HingeRest (kernels/bending.hpp): like
+// the forces, the stiffness belongs to the positions of the last compute_forces().
 #include "kernels/bending.hpp"
 
 namespace dcm {
 
 template <class MemorySpace>
 struct BendingStiffness {
-  Kokkos::View<double* [4][3], Kokkos::LayoutRight, MemorySpace> g;  // scaled ∇θ per hinge and role
-  Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> s;         // per hinge scratch: g · v
+  Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> s;  // per hinge scratch: Δt k_b max(cos, 0) ∇θ · v
+  double dt_k_b = 0;                                          // Δt k_b of the current step (J·s)
   BendingStiffness() = default;
   explicit BendingStiffness(const MeshBuffers<MemorySpace>& mesh)
-      : g("dcm::bending_stiffness::g", mesh.n_hinges), s("dcm::bending_stiffness::s", mesh.n_hinges) {}
+      : s("dcm::bending_stiffness::s", mesh.n_hinges) {}
 };
 
-template <class ExecutionSpace, class MemorySpace>
-void update_bending_stiffness(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                              const HingeRest<MemorySpace>& rest, double k_b, double dt,
-                              const BendingStiffness<MemorySpace>& bs) {
-  const auto x = mesh.x;
-  const auto hinge = mesh.hinge;
-  const auto rest_trig = rest.rest_trig;
-  const auto g = bs.g;
-  Kokkos::parallel_for(
-      "dcm::bending_stiffness::update", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_hinges),
-      KOKKOS_LAMBDA(const int h) {
-        double c, s;
-        Real3 grad[4];
-        hinge_trig_gradient(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
-                            load3(x, hinge(h, 3)), c, s, grad);
-        const double cos_d = c * rest_trig(h, 0) + s * rest_trig(h, 1);  // cos(theta - theta*)
-        const double w = math::sqrt(dt * k_b * math::max(cos_d, 0.0));
-        for (int a = 0; a < 4; ++a) {
-          g(h, a, 0) = w * grad[a].x;
-          g(h, a, 1) = w * grad[a].y;
-          g(h, a, 2) = w * grad[a].z;
-        }
-      });
+// The stiffness of a step dt; ∇θ and cos(θ − θ*) come from the last add_bending_forces()
+// (kernels/bending.hpp).
+template <class MemorySpace>
+void update_bending_stiffness(double k_b, double dt, BendingStiffness<MemorySpace>& bs) {
+  bs.dt_k_b = dt * k_b;
 }
 
 // out += Δt K_bend v.
 template <class ExecutionSpace, class MemorySpace>
 void apply_bending_stiffness(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                             const BendingStiffness<MemorySpace>& bs,
+                             const HingeRest<MemorySpace>& hinges, const BendingStiffness<MemorySpace>& bs,
                              const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& v,
                              const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& out) {
   const auto hinge = mesh.hinge;
-  const auto g = bs.g;
+  const auto g = hinges.hinge_grad;
+  const auto cos_delta = hinges.hinge_cos_delta;
   const auto s = bs.s;
+  const double dt_k_b = bs.dt_k_b;
   Kokkos::parallel_for(
       "dcm::bending_stiffness::project", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_hinges),
       KOKKOS_LAMBDA(const int h) {
@@ -61,7 +46,7 @@ void apply_bending_stiffness(const ExecutionSpace& space, const MeshBuffers<Memo
           const int i = hinge(h, a);
           sum += g(h, a, 0) * v(i, 0) + g(h, a, 1) * v(i, 1) + g(h, a, 2) * v(i, 2);
         }
-        s(h) = sum;
+        s(h) = dt_k_b * math::max(cos_delta(h), 0.0) * sum;
       });
   const auto offsets = mesh.node_hinge_offsets;
   const auto roles = mesh.node_hinge_roles;

@@ -275,7 +275,7 @@ class CortexModel {
     const bool implicit = dt > 0 && global_.has_value();
     const bool implicit_bending = dt > 0 && bending_stiffness_.has_value();
     if (implicit_bending)
-      update_bending_stiffness(space_, mesh_, *hinges_, params_.k_b, dt, *bending_stiffness_);
+      update_bending_stiffness(params_.k_b, dt, *bending_stiffness_);  // ∇θ from compute_forces()
     if (implicit)
       update_global_stiffness(space_, mesh_, geo_, area_ ? area_->cell_area : volume_->cell_volume,
                               volume_ ? volume_->cell_volume : area_->cell_area, params_.k_area_global,
@@ -292,7 +292,8 @@ class CortexModel {
         [&](const Vector& in, const Vector& out) {
           apply_friction(space_, mesh_, friction_, in, out);
           if (implicit) apply_global_stiffness(space_, mesh_, *global_, in, out);
-          if (implicit_bending) apply_bending_stiffness(space_, mesh_, *bending_stiffness_, in, out);
+          if (implicit_bending)
+            apply_bending_stiffness(space_, mesh_, *hinges_, *bending_stiffness_, in, out);
           if (implicit_tension) apply_tension_stiffness(space_, mesh_, *tension_stiffness_, in, out);
         },
         [&](const Vector& in, const Vector& out) {

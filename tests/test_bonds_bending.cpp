@@ -12,6 +12,7 @@
 #include "core/host_copy.hpp"
 #include "kernels/bending.hpp"
 #include "kernels/fene_pow_bonds.hpp"
+#include "solvers/bending_stiffness.hpp"
 
 namespace dcm {
 namespace {
@@ -208,6 +209,65 @@ TEST_F(BondsBendingPerturbed, BendingGatherVariantsAgree) {
   const auto a = s.bending_forces(false), b = s.bending_forces(true);
   const double scale = max_norm(a);
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], 1e-13 * scale) << i;
+}
+
+// The implicit bending operator Δt K_bend v (solvers/bending_stiffness.hpp, built from what the force pass
+// left in HingeRest) against Σ_h Δt k_b max(cos(θ_h − θ*_h), 0) (g_h · v) g_h with g_h = ∇θ_h by central
+// differences of the hinge angle, for a random v.
+TEST_F(BondsBendingPerturbed, BendingStiffnessIsTheGaussNewtonHessianOfTheForcePass) {
+  const Rig<> s(rest, shape);
+  s.bending_forces();  // the hinge pass the stiffness reuses
+  const double dt = 6e-6;
+  BendingStiffness<Mem> bs(s.mesh);
+  update_bending_stiffness(kKb, dt, bs);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<double> v(3 * s.mesh.n_nodes);
+  for (double& c : v) c = u(rng);
+  ForceView<Mem> vin("v", s.mesh.n_nodes), out("out", s.mesh.n_nodes);
+  from_host_vector(vin, v);
+  apply_bending_stiffness(Exec(), s.mesh, s.hinges, bs, vin, out);
+  Exec().fence();
+  const auto got = to_host_vector(out);
+  const auto hinge = to_host_vector(s.mesh.hinge);
+  const auto theta_rest = hinge_rest_angles(s.hinges);
+  std::vector<double> x = to_host_vector(s.mesh.x), ref(v.size(), 0.0);
+  const double h = 1e-6 * edge;
+  auto angle = [&](int k) {
+    auto p = [&](int a) {
+      return Real3{x[3 * hinge[4 * k + a]], x[3 * hinge[4 * k + a] + 1], x[3 * hinge[4 * k + a] + 2]};
+    };
+    return hinge_angle(p(0), p(1), p(2), p(3));
+  };
+  for (std::size_t k = 0; k < theta_rest.size(); ++k) {
+    double g[12];
+    for (int a = 0; a < 4; ++a)
+      for (int c = 0; c < 3; ++c) {
+        double& xc = x[3 * hinge[4 * k + a] + c];
+        const double x0 = xc;
+        xc = x0 + h;
+        const double tp = angle(static_cast<int>(k));
+        xc = x0 - h;
+        const double tm = angle(static_cast<int>(k));
+        xc = x0;
+        g[3 * a + c] = (tp - tm) / (2 * h);
+      }
+    const double w2 = dt * kKb * std::max(std::cos(angle(static_cast<int>(k)) - theta_rest[k]), 0.0);
+    double gv = 0;
+    for (int a = 0; a < 4; ++a)
+      for (int c = 0; c < 3; ++c) gv += g[3 * a + c] * v[3 * hinge[4 * k + a] + c];
+    for (int a = 0; a < 4; ++a)
+      for (int c = 0; c < 3; ++c) ref[3 * hinge[4 * k + a] + c] += w2 * gv * g[3 * a + c];
+  }
+  double d2 = 0, r2 = 0;
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    d2 += (got[i] - ref[i]) * (got[i] - ref[i]);
+    r2 += ref[i] * ref[i];
+  }
+  std::printf("  dt K_bend v against the finite-difference Gauss-Newton operator: relative error %.2e\n",
+              std::sqrt(d2 / r2));
+  EXPECT_GT(r2, 0);
+  EXPECT_LT(std::sqrt(d2 / r2), 1e-6);
 }
 
 TEST(BondsBendingRestShape, ForcesVanish) {
