@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/host_mesh.hpp"
+#include "core/segmented_sum.hpp"
 
 namespace dcm {
 
@@ -36,6 +37,10 @@ struct MeshBuffers {
   View<int*> node_bond_offsets, node_bonds;
   View<int*> node_hinge_offsets, node_hinge_roles;  // hinge entries packed as 4 * hinge + role (0..3)
   View<int*> ring_offsets, ring;                    // one-ring neighbours, counter-clockwise from outside
+
+  // Per-cell sums in a fixed order over the nodes, triangles, bonds, hinges and cells
+  // (core/segmented_sum.hpp).
+  SumPlan<MemorySpace> node_sums, tri_sums, bond_sums, hinge_sums, cell_sums;
 };
 
 // One cell before upload: its surface and the topology derived from it.

@@ -51,6 +51,11 @@ MeshBuffers<MemorySpace> upload_cells(const std::vector<HostCell>& cells) {
   b.cell_tri_begin = vec_view("cell_tri_begin", tb);
   b.cell_bond_begin = vec_view("cell_bond_begin", bb);
   b.cell_hinge_begin = vec_view("cell_hinge_begin", hb);
+  b.node_sums = SumPlan<MemorySpace>(nb);
+  b.tri_sums = SumPlan<MemorySpace>(tb);
+  b.bond_sums = SumPlan<MemorySpace>(bb);
+  b.hinge_sums = SumPlan<MemorySpace>(hb);
+  b.cell_sums = SumPlan<MemorySpace>(std::vector<int>{0, b.n_cells});
 
   // Per-element arrays: walk cells, offset node indices by the cell's first node.
   auto per_cell = [&](auto&& body) {

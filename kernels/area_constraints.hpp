@@ -112,21 +112,17 @@ double area_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& 
   const auto rest_cell_area = rest.cell_area;
   double local = 0, global = 0;
   if (k_a != 0)
-    Kokkos::parallel_reduce(
-        "dcm::area::energy_local", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_tris),
-        KOKKOS_LAMBDA(const int t, double& sum) {
+    local = fixed_order_sum(
+        space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) {
           const double d = area(t) - rest_area(t);
-          sum += 0.5 * k_a * d * d / rest_area(t);
-        },
-        local);
+          return 0.5 * k_a * d * d / rest_area(t);
+        });
   if (k_d != 0)
-    Kokkos::parallel_reduce(
-        "dcm::area::energy_global", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_cells),
-        KOKKOS_LAMBDA(const int c, double& sum) {
+    global = fixed_order_sum(
+        space, mesh.cell_sums, KOKKOS_LAMBDA(const int c) {
           const double d = cell_area(c) - rest_cell_area(c);
-          sum += 0.5 * k_d * d * d / rest_cell_area(c);
-        },
-        global);
+          return 0.5 * k_d * d * d / rest_cell_area(c);
+        });
   return local + global;
 }
 

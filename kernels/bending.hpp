@@ -217,18 +217,14 @@ double bending_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace
   const auto x = mesh.x;
   const auto hinge = mesh.hinge;
   const auto rest_trig = rest.rest_trig;
-  double energy = 0;
-  Kokkos::parallel_reduce(
-      "dcm::bending::energy", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_hinges),
-      KOKKOS_LAMBDA(const int h, double& sum) {
+  return fixed_order_sum(
+      space, mesh.hinge_sums, KOKKOS_LAMBDA(const int h) {
         double c, s;
         Real3 grad[4];
         hinge_trig_gradient(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
                             load3(x, hinge(h, 3)), c, s, grad);
-        sum += k_b * (1 - (c * rest_trig(h, 0) + s * rest_trig(h, 1)));  // 1 - cos(theta - theta*)
-      },
-      energy);
-  return energy;
+        return k_b * (1 - (c * rest_trig(h, 0) + s * rest_trig(h, 1)));  // 1 - cos(theta - theta*)
+      });
 }
 
 }  // namespace dcm

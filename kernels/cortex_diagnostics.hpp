@@ -71,14 +71,12 @@ double contact_power(const ExecutionSpace& space, const MeshBuffers<MemorySpace>
   const auto tri = mesh.tri;
   const auto load = contact.tri_node_load;
   const Real3 n = (1.0 / norm(plane.normal)) * plane.normal;
-  double p = 0;
-  Kokkos::parallel_reduce(
-      "dcm::fields::contact_power", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_tris),
-      KOKKOS_LAMBDA(const int t, double& s) {
+  return fixed_order_sum(
+      space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) {
+        double s = 0;
         for (int c = 0; c < 3; ++c) s += load(t, c) * dot(n, load3(velocity, tri(t, c)));
-      },
-      p);
-  return p;
+        return s;
+      });
 }
 
 }  // namespace dcm

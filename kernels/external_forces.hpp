@@ -16,16 +16,13 @@ void add_external_forces(const ExecutionSpace& space,
       });
 }
 
-// −Σ_i F_i · x_i
+// −Σ_i F_i · x_i, summed in the fixed order of node_sums (mesh.node_sums).
 template <class ExecutionSpace, class MemorySpace>
-double external_energy(const ExecutionSpace& space,
+double external_energy(const ExecutionSpace& space, const SumPlan<MemorySpace>& node_sums,
                        const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& external,
                        const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& x) {
-  double e = 0;
-  Kokkos::parallel_reduce(
-      "dcm::external::energy", Kokkos::RangePolicy<ExecutionSpace>(space, 0, x.extent(0)),
-      KOKKOS_LAMBDA(const int i, double& s) { s -= dot(load3(external, i), load3(x, i)); }, e);
-  return e;
+  return fixed_order_sum(
+      space, node_sums, KOKKOS_LAMBDA(const int i) { return -dot(load3(external, i), load3(x, i)); });
 }
 
 }  // namespace dcm

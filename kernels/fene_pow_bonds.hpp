@@ -141,15 +141,11 @@ double fene_pow_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpac
   const auto rest_length = rest.rest_length;
   const double k_s = params.k_s, x_max = params.x_max;
   const double infinity = std::numeric_limits<double>::infinity();
-  double energy = 0;
-  Kokkos::parallel_reduce(
-      "dcm::bonds::fene_pow_energy", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_bonds),
-      KOKKOS_LAMBDA(const int b, double& sum) {
+  return fixed_order_sum(
+      space, mesh.bond_sums, KOKKOS_LAMBDA(const int b) {
         const double d = norm(load3(x, bond(b, 0)) - load3(x, bond(b, 1))), d_rest = rest_length(b);
-        sum += fene_pow_bond_ok(d, d_rest, x_max) ? fene_pow_bond_energy(d, d_rest, k_s, x_max) : infinity;
-      },
-      energy);
-  return energy;
+        return fene_pow_bond_ok(d, d_rest, x_max) ? fene_pow_bond_energy(d, d_rest, k_s, x_max) : infinity;
+      });
 }
 
 }  // namespace dcm

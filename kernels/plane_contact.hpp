@@ -236,27 +236,23 @@ void add_plane_contact_forces(const ExecutionSpace& space, const MeshBuffers<Mem
       });
 }
 
-namespace detail {
-template <class ExecutionSpace, class View>
-double sum_of(const ExecutionSpace& space, const char* label, const View& v) {
-  double sum = 0;
-  Kokkos::parallel_reduce(
-      label, Kokkos::RangePolicy<ExecutionSpace>(space, 0, v.extent(0)),
-      KOKKOS_LAMBDA(const int t, double& s) { s += v(t); }, sum);
-  return sum;
-}
-}  // namespace detail
-
-// Σ_t A^C_t per cell is what r_cc = sqrt(A^C / π) needs; here the whole mesh (one cell).
+// Σ_t A^C_t per cell is what r_cc = sqrt(A^C / π) needs; here the whole mesh (one cell). Fixed summation
+// order (mesh.tri_sums).
 template <class ExecutionSpace, class MemorySpace>
-double total_contact_area(const ExecutionSpace& space, const ContactBuffers<MemorySpace>& contact) {
-  return detail::sum_of(space, "dcm::contact::area", contact.tri_contact_area);
+double total_contact_area(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                          const ContactBuffers<MemorySpace>& contact) {
+  const auto v = contact.tri_contact_area;
+  return fixed_order_sum(
+      space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) { return v(t); });
 }
 
 // Σ_t F_t · n (N).
 template <class ExecutionSpace, class MemorySpace>
-double total_contact_load(const ExecutionSpace& space, const ContactBuffers<MemorySpace>& contact) {
-  return detail::sum_of(space, "dcm::contact::load", contact.tri_load);
+double total_contact_load(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                          const ContactBuffers<MemorySpace>& contact) {
+  const auto v = contact.tri_load;
+  return fixed_order_sum(
+      space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) { return v(t); });
 }
 
 }  // namespace dcm

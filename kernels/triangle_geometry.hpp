@@ -52,32 +52,27 @@ void compute_triangle_geometry(const ExecutionSpace& space, const MeshBuffers<Me
       });
 }
 
-// Per-cell A and V. Needs no other geometry. One pair of reductions per cell over its triangle range,
-// each reducing straight into the cell's entry of a device View (no host round trip, no allocation).
-// A batched many-cell variant (one launch for all cells) belongs with the batched engine.
+// Per-cell A and V. Needs no other geometry. One launch for all cells, summed in an order fixed by the cell
+// alone (core/segmented_sum.hpp): the same bits on any thread count.
+template <class MemorySpace>
+struct CellMeasuresOut {
+  Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> area, volume;
+  KOKKOS_INLINE_FUNCTION double& operator()(int c, int k) const { return k == 0 ? area(c) : volume(c); }
+};
+
 template <class ExecutionSpace, class MemorySpace>
 void compute_cell_measures(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                            const GeometryBuffers<MemorySpace>& geo) {
   const auto x = mesh.x;
   const auto tri = mesh.tri;
-  for (int c = 0; c < mesh.n_cells; ++c) {
-    const Kokkos::RangePolicy<ExecutionSpace> range(space, mesh.host_cell_tri_begin[c],
-                                                    mesh.host_cell_tri_begin[c + 1]);
-    Kokkos::parallel_reduce(
-        "dcm::geometry::cell_area", range,
-        KOKKOS_LAMBDA(const int t, double& sum) {
-          const Real3 p0 = load3(x, tri(t, 0)), p1 = load3(x, tri(t, 1)), p2 = load3(x, tri(t, 2));
-          sum += 0.5 * norm(cross(p1 - p0, p2 - p0));  // A = sum_t A_t
-        },
-        Kokkos::subview(geo.cell_area, c));
-    Kokkos::parallel_reduce(
-        "dcm::geometry::cell_volume", range,
-        KOKKOS_LAMBDA(const int t, double& sum) {
-          const Real3 p0 = load3(x, tri(t, 0)), p1 = load3(x, tri(t, 1)), p2 = load3(x, tri(t, 2));
-          sum += dot(p0, cross(p1, p2)) / 6.0;  // V = sum_t x0 . (x1 x x2) / 6
-        },
-        Kokkos::subview(geo.cell_volume, c));
-  }
+  segmented_sum<2>(
+      space, mesh.tri_sums,
+      KOKKOS_LAMBDA(const int t, double(&sum)[2]) {
+        const Real3 p0 = load3(x, tri(t, 0)), p1 = load3(x, tri(t, 1)), p2 = load3(x, tri(t, 2));
+        sum[0] += 0.5 * norm(cross(p1 - p0, p2 - p0));  // A = sum_t A_t
+        sum[1] += dot(p0, cross(p1, p2)) / 6.0;         // V = sum_t x0 . (x1 x x2) / 6
+      },
+      CellMeasuresOut<MemorySpace>{geo.cell_area, geo.cell_volume});
 }
 
 }  // namespace dcm

@@ -86,15 +86,11 @@ double volume_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>
                      double k_v) {
   const auto volume = geo.cell_volume;
   const auto rest_volume = rest.cell_volume;
-  double e = 0;
-  Kokkos::parallel_reduce(
-      "dcm::volume::energy", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_cells),
-      KOKKOS_LAMBDA(const int c, double& sum) {
+  return fixed_order_sum(
+      space, mesh.cell_sums, KOKKOS_LAMBDA(const int c) {
         const double d = volume(c) - rest_volume(c);
-        sum += 0.5 * k_v * d * d / rest_volume(c);
-      },
-      e);
-  return e;
+        return 0.5 * k_v * d * d / rest_volume(c);
+      });
 }
 
 }  // namespace dcm

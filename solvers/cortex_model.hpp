@@ -185,8 +185,10 @@ class CortexModel {
   double contact_power() const {
     return contact_ ? dcm::contact_power(space_, mesh_, params_.plane, *contact_, velocity_) : 0.0;
   }
-  double contact_area() const { return contact_ ? total_contact_area(space_, *contact_) : 0.0; }  // Σ A^C_t
-  double contact_load() const { return contact_ ? total_contact_load(space_, *contact_) : 0.0; }  // N
+  double contact_area() const {
+    return contact_ ? total_contact_area(space_, mesh_, *contact_) : 0.0;
+  }  // Σ A^C_t
+  double contact_load() const { return contact_ ? total_contact_load(space_, mesh_, *contact_) : 0.0; }  // N
 
   // Geometry, then the total force on every node.
   void compute_forces() {
@@ -218,8 +220,8 @@ class CortexModel {
   // Total energy for the current positions (calls update_geometry()).
   double energy() {
     update_geometry(space_, mesh_, geo_, params_.h_min);
-    double e = external_energy(space_, external_, mesh_.x);
-    if (gravity_) e += external_energy(space_, *gravity_, mesh_.x);
+    double e = external_energy(space_, mesh_.node_sums, external_, mesh_.x);
+    if (gravity_) e += external_energy(space_, mesh_.node_sums, *gravity_, mesh_.x);
     if (bonds_) e += fene_pow_energy(space_, mesh_, *bonds_, params_.bonds);
     if (hinges_) e += bending_energy(space_, mesh_, *hinges_, params_.k_b);
     if (area_) e += area_energy(space_, mesh_, geo_, *area_, params_.k_area_local, params_.k_area_global);
@@ -318,7 +320,7 @@ class CortexModel {
 
   // F · v: the rate at which the forces do work on the current velocity (W); with the explicit step it
   // equals the dissipation vᵀΓv, with the implicit global terms it is vᵀ(Γ + dt K)v.
-  double power() { return cg_detail::dot(space_, force_, velocity_); }
+  double power() { return cg_detail::dot(space_, cg_.sums, force_, velocity_); }
 
   // The node with the largest total force (the first, if several); for messages.
   int largest_force_node() const {
@@ -370,7 +372,7 @@ class CortexModel {
     FrictionOperator<Mem> gamma = friction_;  // Γ alone, without the implicit bond stiffness
     gamma.bond_stiffness_dt = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
     apply_friction(space_, mesh_, gamma, velocity_, cg_.q);
-    return cg_detail::dot(space_, velocity_, cg_.q);
+    return cg_detail::dot(space_, cg_.sums, velocity_, cg_.q);
   }
 
  private:

@@ -72,6 +72,12 @@ void update_global_stiffness(const ExecutionSpace& space, const MeshBuffers<Memo
       });
 }
 
+template <class MemorySpace>
+struct GlobalDotsOut {
+  Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> area, volume;
+  KOKKOS_INLINE_FUNCTION double& operator()(int c, int k) const { return k == 0 ? area(c) : volume(c); }
+};
+
 // out += Δt K_global v.
 template <class ExecutionSpace, class MemorySpace>
 void apply_global_stiffness(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
@@ -80,20 +86,14 @@ void apply_global_stiffness(const ExecutionSpace& space, const MeshBuffers<Memor
                             const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& out) {
   const auto grad_area = g.grad_area, grad_volume = g.grad_volume;
   const bool with_area = g.area, with_volume = g.volume;
-  for (int c = 0; c < mesh.n_cells; ++c) {
-    const Kokkos::RangePolicy<ExecutionSpace> range(space, mesh.host_cell_node_begin[c],
-                                                    mesh.host_cell_node_begin[c + 1]);
-    if (with_area)
-      Kokkos::parallel_reduce(
-          "dcm::global::dot_area", range,
-          KOKKOS_LAMBDA(const int i, double& s) { s += dot(load3(grad_area, i), load3(v, i)); },
-          Kokkos::subview(g.dot_area, c));
-    if (with_volume)
-      Kokkos::parallel_reduce(
-          "dcm::global::dot_volume", range,
-          KOKKOS_LAMBDA(const int i, double& s) { s += dot(load3(grad_volume, i), load3(v, i)); },
-          Kokkos::subview(g.dot_volume, c));
-  }
+  segmented_sum<2>(
+      space, mesh.node_sums,
+      KOKKOS_LAMBDA(const int i, double(&s)[2]) {
+        const Real3 vi = load3(v, i);
+        if (with_area) s[0] += dot(load3(grad_area, i), vi);
+        if (with_volume) s[1] += dot(load3(grad_volume, i), vi);
+      },
+      GlobalDotsOut<MemorySpace>{g.dot_area, g.dot_volume});
   const auto node_cell = mesh.node_cell;
   const auto coef_area = g.coef_area, coef_volume = g.coef_volume, dot_area = g.dot_area,
              dot_volume = g.dot_volume;

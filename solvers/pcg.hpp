@@ -4,6 +4,7 @@
 // precondition(r, z). The iterate x is the warm start on entry and the solution on exit.
 // Stops when ||r||₂ ≤ max(abs_tol, rel_tol ||b||₂); the paper's setting is an absolute force residual
 // of 1e-14 N. Reaching max_iterations is reported (converged = false), never silently accepted.
+#include "core/segmented_sum.hpp"
 #include "core/vec3.hpp"
 
 namespace dcm {
@@ -24,12 +25,14 @@ template <class MemorySpace>
 struct CgWorkspace {
   using Vector = Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>;
   Vector r, z, p, q;
+  SumPlan<MemorySpace> sums;  // the dot products: thread-count independent (core/segmented_sum.hpp)
   CgWorkspace() = default;
   explicit CgWorkspace(int n)
       : r(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::cg::r"), n),
         z(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::cg::z"), n),
         p(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::cg::p"), n),
-        q(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::cg::q"), n) {}
+        q(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::cg::q"), n),
+        sums(std::vector<int>{0, n}) {}
 };
 
 namespace cg_detail {
@@ -46,6 +49,19 @@ double dot(const ExecutionSpace& space, const Vector& a, const Vector& b) {
   return sum;
 }
 
+// a · b with the workspace's fixed summation order.
+template <class ExecutionSpace, class MemorySpace, class Vector>
+double dot(const ExecutionSpace& space, const SumPlan<MemorySpace>& plan, const Vector& a, const Vector& b) {
+  double sum[1];
+  segmented_total<1>(
+      space, plan,
+      KOKKOS_LAMBDA(const int i, double(&acc)[1]) {
+        acc[0] += a(i, 0) * b(i, 0) + a(i, 1) * b(i, 1) + a(i, 2) * b(i, 2);
+      },
+      sum);
+  return sum[0];
+}
+
 }  // namespace cg_detail
 
 template <class ExecutionSpace, class Vector, class Apply, class Precondition, class Workspace>
@@ -55,50 +71,50 @@ CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& pr
   const int n = static_cast<int>(b.extent(0));
   const auto r = w.r, z = w.z, p = w.p, q = w.q;
   CgResult result;
-  result.rhs_norm = math::sqrt(cg_detail::dot(space, b, b));
+  const auto& sums = w.sums;
+  result.rhs_norm = math::sqrt(cg_detail::dot(space, sums, b, b));
   const double tol = math::max(settings.abs_tol, settings.rel_tol * result.rhs_norm);
 
   apply(x, q);  // r = b - Γ x
-  double rr = 0;
-  Kokkos::parallel_reduce(
-      "dcm::cg::initial_residual", Policy(space, 0, n),
-      KOKKOS_LAMBDA(const int i, double& s) {
+  double rr[1];
+  segmented_total<1>(
+      space, sums,
+      KOKKOS_LAMBDA(const int i, double(&s)[1]) {
         for (int d = 0; d < 3; ++d) {
           r(i, d) = b(i, d) - q(i, d);
-          s += r(i, d) * r(i, d);
+          s[0] += r(i, d) * r(i, d);
         }
       },
       rr);
-  result.residual_norm = math::sqrt(rr);
+  result.residual_norm = math::sqrt(rr[0]);
   if (result.residual_norm <= tol) {
     result.converged = true;
     return result;
   }
   precondition(r, z);
   Kokkos::deep_copy(space, p, z);
-  double rz = cg_detail::dot(space, r, z);
+  double rz = cg_detail::dot(space, sums, r, z);
   for (int it = 1; it <= settings.max_iterations; ++it) {
     apply(p, q);
-    const double alpha = rz / cg_detail::dot(space, p, q);
-    rr = 0;
-    Kokkos::parallel_reduce(
-        "dcm::cg::update", Policy(space, 0, n),
-        KOKKOS_LAMBDA(const int i, double& s) {
+    const double alpha = rz / cg_detail::dot(space, sums, p, q);
+    segmented_total<1>(
+        space, sums,
+        KOKKOS_LAMBDA(const int i, double(&s)[1]) {
           for (int d = 0; d < 3; ++d) {
             x(i, d) += alpha * p(i, d);
             r(i, d) -= alpha * q(i, d);
-            s += r(i, d) * r(i, d);
+            s[0] += r(i, d) * r(i, d);
           }
         },
         rr);
     result.iterations = it;
-    result.residual_norm = math::sqrt(rr);
+    result.residual_norm = math::sqrt(rr[0]);
     if (!(result.residual_norm > tol)) {  // also stops on NaN; the caller checks finiteness
       result.converged = result.residual_norm <= tol;
       return result;
     }
     precondition(r, z);
-    const double rz_new = cg_detail::dot(space, r, z);
+    const double rz_new = cg_detail::dot(space, sums, r, z);
     const double beta = rz_new / rz;
     rz = rz_new;
     Kokkos::parallel_for(

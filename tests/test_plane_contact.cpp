@@ -299,7 +299,7 @@ struct MovableSphere {
     const Exec space;
     update_geometry(space, mesh, geo, 1e4);
     compute_plane_contact(space, mesh, geo, Plane{}, prm, contact);
-    return total_contact_load(space, contact);
+    return total_contact_load(space, mesh, contact);
   }
 };
 
