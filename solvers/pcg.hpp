@@ -37,19 +37,7 @@ struct CgWorkspace {
 
 namespace cg_detail {
 
-template <class ExecutionSpace, class Vector>
-double dot(const ExecutionSpace& space, const Vector& a, const Vector& b) {
-  double sum = 0;
-  Kokkos::parallel_reduce(
-      "dcm::cg::dot", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.extent(0)),
-      KOKKOS_LAMBDA(const int i, double& s) {
-        s += a(i, 0) * b(i, 0) + a(i, 1) * b(i, 1) + a(i, 2) * b(i, 2);
-      },
-      sum);
-  return sum;
-}
-
-// a · b with the workspace's fixed summation order.
+// a · b summed in the plan's fixed order (core/segmented_sum.hpp): the same bits on any thread count.
 template <class ExecutionSpace, class MemorySpace, class Vector>
 double dot(const ExecutionSpace& space, const SumPlan<MemorySpace>& plan, const Vector& a, const Vector& b) {
   double sum[1];
