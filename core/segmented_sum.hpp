@@ -6,6 +6,9 @@
 // sums in order. A Kokkos::parallel_reduce instead combines per-thread partial sums, so its last bits change
 // with OMP_NUM_THREADS; with these sums a run is bitwise the same on 1 and 2 threads (ctest
 // app.spread_thread_independent), and a cell's sums do not depend on the other cells of a batch.
+// Cost: two launches and a host copy per sum instead of one reduction; on the CPU the same time (bench_step).
+// On a GPU a work item per 64 consecutive elements reads uncoalesced; a fixed warp-level tree per chunk would
+// keep the order and read coalesced (not done: no GPU to measure it on).
 //
 //   SumPlan<Mem> plan(host_begin);                       // once per mesh (host offsets, n_segments + 1)
 //   segmented_sum<2>(space, plan, KOKKOS_LAMBDA(int k, double (&acc)[2]) { acc[0] += ...; acc[1] += ...; },
