@@ -138,7 +138,7 @@ FdError compare(const std::vector<double>& f, const std::vector<double>& fd) {
   }
   FdError e;
   e.global = std::sqrt(diff2 / norm2);
-  const double rms = std::sqrt(norm2 / (f.size() / 3));
+  const double rms = std::sqrt(norm2 / static_cast<double>(f.size() / 3));
   for (std::size_t i = 0; i < f.size() / 3; ++i) {
     const double fi = node_norm(f, i);
     if (fi < 0.1 * rms) continue;
