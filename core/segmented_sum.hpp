@@ -11,9 +11,11 @@
 // keep the order and read coalesced (not done: no GPU to measure it on).
 //
 //   SumPlan<Mem> plan(host_begin);                       // once per mesh (host offsets, n_segments + 1)
-//   segmented_sum<2>(space, plan, KOKKOS_LAMBDA(int k, double (&acc)[2]) { acc[0] += ...; acc[1] += ...; },
+//   segmented_sum<2>("dcm::x::y", space, plan,           // the label names both kernels (label,
+//   label::segments)
+//                    KOKKOS_LAMBDA(int k, double (&acc)[2]) { acc[0] += ...; acc[1] += ...; },
 //                    out);                                // out(s, 0..1) for every segment s
-//   double total = fixed_order_sum(space, plan, KOKKOS_LAMBDA(int k) { return ...; });  // all segments, host
+//   double total = fixed_order_sum("dcm::x::y", space, plan, KOKKOS_LAMBDA(int k) { return ...; });  // host
 #include <Kokkos_Core.hpp>
 #include <string>
 #include <vector>
@@ -67,23 +69,23 @@ struct SumPlan {
 
 // out(s, c) = Σ over the elements k of segment s of the c-th component term(k, acc) adds, for c < N.
 // term may also write per-element results (each element is visited exactly once).
+// The kernels are labelled `label` (chunks) and `label`::segments, so profiles keep the caller's name.
 template <int N, class ExecutionSpace, class MemorySpace, class Term, class Out>
-void segmented_sum(const ExecutionSpace& space, const SumPlan<MemorySpace>& plan, const Term& term,
-                   const Out& out) {
+void segmented_sum(const std::string& label, const ExecutionSpace& space, const SumPlan<MemorySpace>& plan,
+                   const Term& term, const Out& out) {
   static_assert(N >= 1 && N <= kSumMaxComponents, "segmented_sum: 1 to 4 components");
   const auto range = plan.chunk_range;
   const auto partial = plan.partial;
   const auto chunks = plan.segment_chunks;
   Kokkos::parallel_for(
-      "dcm::sum::chunks", Kokkos::RangePolicy<ExecutionSpace>(space, 0, plan.n_chunks),
-      KOKKOS_LAMBDA(const int q) {
+      label, Kokkos::RangePolicy<ExecutionSpace>(space, 0, plan.n_chunks), KOKKOS_LAMBDA(const int q) {
         double acc[N];
         for (int c = 0; c < N; ++c) acc[c] = 0;
         for (int k = range(q, 0); k < range(q, 1); ++k) term(k, acc);
         for (int c = 0; c < N; ++c) partial(q, c) = acc[c];
       });
   Kokkos::parallel_for(
-      "dcm::sum::segments", Kokkos::RangePolicy<ExecutionSpace>(space, 0, plan.n_segments),
+      label + "::segments", Kokkos::RangePolicy<ExecutionSpace>(space, 0, plan.n_segments),
       KOKKOS_LAMBDA(const int s) {
         double acc[N];
         for (int c = 0; c < N; ++c) acc[c] = 0;
@@ -95,9 +97,9 @@ void segmented_sum(const ExecutionSpace& space, const SumPlan<MemorySpace>& plan
 
 // The sums over all segments (the segments added in order), on the host.
 template <int N, class ExecutionSpace, class MemorySpace, class Term>
-void segmented_total(const ExecutionSpace& space, const SumPlan<MemorySpace>& plan, const Term& term,
-                     double (&total)[N]) {
-  segmented_sum<N>(space, plan, term, plan.result);
+void segmented_total(const std::string& label, const ExecutionSpace& space, const SumPlan<MemorySpace>& plan,
+                     const Term& term, double (&total)[N]) {
+  segmented_sum<N>(label, space, plan, term, plan.result);
   Kokkos::deep_copy(space, plan.result_host, plan.result);
   space.fence();
   for (int c = 0; c < N; ++c) total[c] = 0;
@@ -107,10 +109,11 @@ void segmented_total(const ExecutionSpace& space, const SumPlan<MemorySpace>& pl
 
 // One component: Σ term over every element of the plan, in the fixed order.
 template <class ExecutionSpace, class MemorySpace, class Term>
-double fixed_order_sum(const ExecutionSpace& space, const SumPlan<MemorySpace>& plan, const Term& term) {
+double fixed_order_sum(const std::string& label, const ExecutionSpace& space,
+                       const SumPlan<MemorySpace>& plan, const Term& term) {
   double total[1];
   segmented_total<1>(
-      space, plan, KOKKOS_LAMBDA(const int k, double(&acc)[1]) { acc[0] += term(k); }, total);
+      label, space, plan, KOKKOS_LAMBDA(const int k, double(&acc)[1]) { acc[0] += term(k); }, total);
   return total[0];
 }
 

@@ -113,13 +113,13 @@ double area_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& 
   double local = 0, global = 0;
   if (k_a != 0)
     local = fixed_order_sum(
-        space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) {
+        "dcm::area::energy_local", space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) {
           const double d = area(t) - rest_area(t);
           return 0.5 * k_a * d * d / rest_area(t);
         });
   if (k_d != 0)
     global = fixed_order_sum(
-        space, mesh.cell_sums, KOKKOS_LAMBDA(const int c) {
+        "dcm::area::energy_global", space, mesh.cell_sums, KOKKOS_LAMBDA(const int c) {
           const double d = cell_area(c) - rest_cell_area(c);
           return 0.5 * k_d * d * d / rest_cell_area(c);
         });

@@ -218,7 +218,7 @@ double bending_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace
   const auto hinge = mesh.hinge;
   const auto rest_trig = rest.rest_trig;
   return fixed_order_sum(
-      space, mesh.hinge_sums, KOKKOS_LAMBDA(const int h) {
+      "dcm::bending::energy", space, mesh.hinge_sums, KOKKOS_LAMBDA(const int h) {
         double c, s;
         Real3 grad[4];
         hinge_trig_gradient(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),

@@ -72,7 +72,7 @@ double contact_power(const ExecutionSpace& space, const MeshBuffers<MemorySpace>
   const auto load = contact.tri_node_load;
   const Real3 n = (1.0 / norm(plane.normal)) * plane.normal;
   return fixed_order_sum(
-      space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) {
+      "dcm::fields::contact_power", space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) {
         double s = 0;
         for (int c = 0; c < 3; ++c) s += load(t, c) * dot(n, load3(velocity, tri(t, c)));
         return s;

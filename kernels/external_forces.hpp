@@ -22,7 +22,8 @@ double external_energy(const ExecutionSpace& space, const SumPlan<MemorySpace>& 
                        const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& external,
                        const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& x) {
   return fixed_order_sum(
-      space, node_sums, KOKKOS_LAMBDA(const int i) { return -dot(load3(external, i), load3(x, i)); });
+      "dcm::external::energy", space, node_sums,
+      KOKKOS_LAMBDA(const int i) { return -dot(load3(external, i), load3(x, i)); });
 }
 
 }  // namespace dcm

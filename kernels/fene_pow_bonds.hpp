@@ -142,7 +142,7 @@ double fene_pow_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpac
   const double k_s = params.k_s, x_max = params.x_max;
   const double infinity = std::numeric_limits<double>::infinity();
   return fixed_order_sum(
-      space, mesh.bond_sums, KOKKOS_LAMBDA(const int b) {
+      "dcm::bonds::fene_pow_energy", space, mesh.bond_sums, KOKKOS_LAMBDA(const int b) {
         const double d = norm(load3(x, bond(b, 0)) - load3(x, bond(b, 1))), d_rest = rest_length(b);
         return fene_pow_bond_ok(d, d_rest, x_max) ? fene_pow_bond_energy(d, d_rest, k_s, x_max) : infinity;
       });

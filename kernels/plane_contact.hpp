@@ -243,7 +243,7 @@ double total_contact_area(const ExecutionSpace& space, const MeshBuffers<MemoryS
                           const ContactBuffers<MemorySpace>& contact) {
   const auto v = contact.tri_contact_area;
   return fixed_order_sum(
-      space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) { return v(t); });
+      "dcm::contact::area", space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) { return v(t); });
 }
 
 // Σ_t F_t · n (N).
@@ -252,7 +252,7 @@ double total_contact_load(const ExecutionSpace& space, const MeshBuffers<MemoryS
                           const ContactBuffers<MemorySpace>& contact) {
   const auto v = contact.tri_load;
   return fixed_order_sum(
-      space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) { return v(t); });
+      "dcm::contact::load", space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) { return v(t); });
 }
 
 }  // namespace dcm

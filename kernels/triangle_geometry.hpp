@@ -66,7 +66,7 @@ void compute_cell_measures(const ExecutionSpace& space, const MeshBuffers<Memory
   const auto x = mesh.x;
   const auto tri = mesh.tri;
   segmented_sum<2>(
-      space, mesh.tri_sums,
+      "dcm::geometry::cell_measures", space, mesh.tri_sums,
       KOKKOS_LAMBDA(const int t, double(&sum)[2]) {
         const Real3 p0 = load3(x, tri(t, 0)), p1 = load3(x, tri(t, 1)), p2 = load3(x, tri(t, 2));
         sum[0] += 0.5 * norm(cross(p1 - p0, p2 - p0));  // A = sum_t A_t

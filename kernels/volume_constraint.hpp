@@ -87,7 +87,7 @@ double volume_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>
   const auto volume = geo.cell_volume;
   const auto rest_volume = rest.cell_volume;
   return fixed_order_sum(
-      space, mesh.cell_sums, KOKKOS_LAMBDA(const int c) {
+      "dcm::volume::energy", space, mesh.cell_sums, KOKKOS_LAMBDA(const int c) {
         const double d = volume(c) - rest_volume(c);
         return 0.5 * k_v * d * d / rest_volume(c);
       });

@@ -31,7 +31,6 @@ GROUPS = [
     ("CG", ("dcm::cg::", "dcm::friction::apply", "dcm::friction::precondition", "dcm::bsr::", "dcm::mg::",
             "dcm::global::", "dcm::bending_stiffness::", "dcm::tension_stiffness::")),
     ("integrator", ("dcm::integrator::", "dcm::model::", "dcm::stepper::", "dcm::external::")),
-    ("fixed-order sums", ("dcm::sum::",)),  # core/segmented_sum.hpp: CG dots, cell measures, energies (session 6)
 ]
 
 

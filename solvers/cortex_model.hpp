@@ -320,7 +320,7 @@ class CortexModel {
 
   // F · v: the rate at which the forces do work on the current velocity (W); with the explicit step it
   // equals the dissipation vᵀΓv, with the implicit global terms it is vᵀ(Γ + dt K)v.
-  double power() { return cg_detail::dot(space_, cg_.sums, force_, velocity_); }
+  double power() { return cg_detail::dot(space_, cg_.sums, force_, velocity_, "dcm::model::power"); }
 
   // The node with the largest total force (the first, if several); for messages.
   int largest_force_node() const {
@@ -372,7 +372,7 @@ class CortexModel {
     FrictionOperator<Mem> gamma = friction_;  // Γ alone, without the implicit bond stiffness
     gamma.bond_stiffness_dt = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
     apply_friction(space_, mesh_, gamma, velocity_, cg_.q);
-    return cg_detail::dot(space_, cg_.sums, velocity_, cg_.q);
+    return cg_detail::dot(space_, cg_.sums, velocity_, cg_.q, "dcm::model::dissipation");
   }
 
  private:

@@ -69,8 +69,9 @@ FireResult fire_minimize(CortexModel<ExecutionSpace>& model, const FireSettings&
     ++r.steps;
     // FIRE mixing: u <- (1 - alpha) u + alpha |u| F/|F|, using the power P = F·u.
     const auto& sums = model.mesh().node_sums;  // fixed-order dot products
-    const double p = cg_detail::dot(space, sums, f, u), uu = cg_detail::dot(space, sums, u, u),
-                 ff = cg_detail::dot(space, sums, f, f);
+    const double p = cg_detail::dot(space, sums, f, u, "dcm::fire::dot"),
+                 uu = cg_detail::dot(space, sums, u, u, "dcm::fire::dot"),
+                 ff = cg_detail::dot(space, sums, f, f, "dcm::fire::dot");
     if (p > 0) {
       const double mix = alpha * std::sqrt(uu / ff);
       const double keep = 1 - alpha;

@@ -87,7 +87,7 @@ void apply_global_stiffness(const ExecutionSpace& space, const MeshBuffers<Memor
   const auto grad_area = g.grad_area, grad_volume = g.grad_volume;
   const bool with_area = g.area, with_volume = g.volume;
   segmented_sum<2>(
-      space, mesh.node_sums,
+      "dcm::global::dots", space, mesh.node_sums,
       KOKKOS_LAMBDA(const int i, double(&s)[2]) {
         const Real3 vi = load3(v, i);
         if (with_area) s[0] += dot(load3(grad_area, i), vi);

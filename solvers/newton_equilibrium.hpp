@@ -91,12 +91,12 @@ NewtonResult newton_equilibrium(CortexModel<ExecutionSpace>& model, const Newton
     Kokkos::deep_copy(space, delta, 0.0);
     Kokkos::deep_copy(space, r, f0);
     Kokkos::deep_copy(space, p, f0);
-    double rr = cg_detail::dot(space, sums, r, r);
+    double rr = cg_detail::dot(space, sums, r, r, "dcm::newton::dot");
     const double stop = s.cg_rel_tol * s.cg_rel_tol * rr;
     int it = 0;
     for (; it < s.max_cg_iterations && rr > stop; ++it) {
       apply_hessian(p, hp, mu);
-      const double php = cg_detail::dot(space, sums, p, hp);
+      const double php = cg_detail::dot(space, sums, p, hp, "dcm::newton::dot");
       if (!(php > 0)) {
         if (it == 0) axpy("dcm::newton::steepest", delta, 1.0 / mu, p);  // fall back to a gradient step
         break;
@@ -104,7 +104,7 @@ NewtonResult newton_equilibrium(CortexModel<ExecutionSpace>& model, const Newton
       const double alpha = rr / php;
       axpy("dcm::newton::x_update", delta, alpha, p);
       axpy("dcm::newton::r_update", r, -alpha, hp);
-      const double rr_new = cg_detail::dot(space, sums, r, r);
+      const double rr_new = cg_detail::dot(space, sums, r, r, "dcm::newton::dot");
       const double beta = rr_new / rr;
       rr = rr_new;
       Kokkos::parallel_for(

@@ -39,10 +39,11 @@ namespace cg_detail {
 
 // a · b summed in the plan's fixed order (core/segmented_sum.hpp): the same bits on any thread count.
 template <class ExecutionSpace, class MemorySpace, class Vector>
-double dot(const ExecutionSpace& space, const SumPlan<MemorySpace>& plan, const Vector& a, const Vector& b) {
+double dot(const ExecutionSpace& space, const SumPlan<MemorySpace>& plan, const Vector& a, const Vector& b,
+           const char* label = "dcm::cg::dot") {
   double sum[1];
   segmented_total<1>(
-      space, plan,
+      label, space, plan,
       KOKKOS_LAMBDA(const int i, double(&acc)[1]) {
         acc[0] += a(i, 0) * b(i, 0) + a(i, 1) * b(i, 1) + a(i, 2) * b(i, 2);
       },
@@ -66,7 +67,7 @@ CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& pr
   apply(x, q);  // r = b - Γ x
   double rr[1];
   segmented_total<1>(
-      space, sums,
+      "dcm::cg::initial_residual", space, sums,
       KOKKOS_LAMBDA(const int i, double(&s)[1]) {
         for (int d = 0; d < 3; ++d) {
           r(i, d) = b(i, d) - q(i, d);
@@ -86,7 +87,7 @@ CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& pr
     apply(p, q);
     const double alpha = rz / cg_detail::dot(space, sums, p, q);
     segmented_total<1>(
-        space, sums,
+        "dcm::cg::update", space, sums,
         KOKKOS_LAMBDA(const int i, double(&s)[1]) {
           for (int d = 0; d < 3; ++d) {
             x(i, d) += alpha * p(i, d);
