@@ -95,6 +95,14 @@ void segmented_sum(const std::string& label, const ExecutionSpace& space, const 
       });
 }
 
+// Two per-segment Views as the `out` of a two-component segmented_sum: out(s, 0) = first(s), out(s, 1) =
+// second(s).
+template <class MemorySpace>
+struct PairOut {
+  Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> first, second;
+  KOKKOS_INLINE_FUNCTION double& operator()(int s, int k) const { return k == 0 ? first(s) : second(s); }
+};
+
 // The sums over all segments (the segments added in order), on the host.
 template <int N, class ExecutionSpace, class MemorySpace, class Term>
 void segmented_total(const std::string& label, const ExecutionSpace& space, const SumPlan<MemorySpace>& plan,

@@ -54,12 +54,6 @@ void compute_triangle_geometry(const ExecutionSpace& space, const MeshBuffers<Me
 
 // Per-cell A and V. Needs no other geometry. One launch for all cells, summed in an order fixed by the cell
 // alone (core/segmented_sum.hpp): the same bits on any thread count.
-template <class MemorySpace>
-struct CellMeasuresOut {
-  Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> area, volume;
-  KOKKOS_INLINE_FUNCTION double& operator()(int c, int k) const { return k == 0 ? area(c) : volume(c); }
-};
-
 template <class ExecutionSpace, class MemorySpace>
 void compute_cell_measures(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                            const GeometryBuffers<MemorySpace>& geo) {
@@ -72,7 +66,7 @@ void compute_cell_measures(const ExecutionSpace& space, const MeshBuffers<Memory
         sum[0] += 0.5 * norm(cross(p1 - p0, p2 - p0));  // A = sum_t A_t
         sum[1] += dot(p0, cross(p1, p2)) / 6.0;         // V = sum_t x0 . (x1 x x2) / 6
       },
-      CellMeasuresOut<MemorySpace>{geo.cell_area, geo.cell_volume});
+      PairOut<MemorySpace>{geo.cell_area, geo.cell_volume});
 }
 
 }  // namespace dcm

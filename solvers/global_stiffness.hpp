@@ -72,12 +72,6 @@ void update_global_stiffness(const ExecutionSpace& space, const MeshBuffers<Memo
       });
 }
 
-template <class MemorySpace>
-struct GlobalDotsOut {
-  Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> area, volume;
-  KOKKOS_INLINE_FUNCTION double& operator()(int c, int k) const { return k == 0 ? area(c) : volume(c); }
-};
-
 // out += Δt K_global v.
 template <class ExecutionSpace, class MemorySpace>
 void apply_global_stiffness(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
@@ -93,7 +87,7 @@ void apply_global_stiffness(const ExecutionSpace& space, const MeshBuffers<Memor
         if (with_area) s[0] += dot(load3(grad_area, i), vi);
         if (with_volume) s[1] += dot(load3(grad_volume, i), vi);
       },
-      GlobalDotsOut<MemorySpace>{g.dot_area, g.dot_volume});
+      PairOut<MemorySpace>{g.dot_area, g.dot_volume});
   const auto node_cell = mesh.node_cell;
   const auto coef_area = g.coef_area, coef_volume = g.coef_volume, dot_area = g.dot_area,
              dot_volume = g.dot_volume;
