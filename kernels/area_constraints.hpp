@@ -19,6 +19,7 @@
 // compute_cell_measures() (cell_area), i.e. update_geometry().
 // Expectations (tests/test_constraints.cpp): forces = -grad E by central differences (relative error
 // < 1e-6) for each term; zero at the rest shape; zero net force and torque; cells independent.
+#include "core/cell_params.hpp"
 #include "core/geometry.hpp"
 #include "core/vec3.hpp"
 #include "kernels/rest_state.hpp"
@@ -48,10 +49,10 @@ AreaRest<MemorySpace> make_area_rest(const ExecutionSpace& space, const MeshBuff
 namespace detail {
 
 // Local and/or global term, chosen at compile time so a zero constant costs nothing.
-template <bool Local, bool Global, class ExecutionSpace, class MemorySpace>
+template <bool Local, bool Global, class ExecutionSpace, class MemorySpace, class KA, class KD>
 void add_area_forces_impl(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                           const GeometryBuffers<MemorySpace>& geo, const AreaRest<MemorySpace>& rest,
-                          double k_a, double k_d,
+                          const KA& k_a_cells, const KD& k_d_cells,
                           const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& force) {
   const auto x = mesh.x;
   const auto tri = mesh.tri;
@@ -66,16 +67,17 @@ void add_area_forces_impl(const ExecutionSpace& space, const MeshBuffers<MemoryS
   Kokkos::parallel_for(
       "dcm::area::forces", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
+        const int cell = node_cell(i);
         double global = 0;  // eq. 28: k_d (A_c - A_c*) / A_c*, the same for every triangle of the cell
-        if constexpr (Global) {
-          const int c = node_cell(i);
-          global = k_d * (cell_area(c) - rest_cell_area(c)) / rest_cell_area(c);
-        }
+        if constexpr (Global)
+          global =
+              cell_value(k_d_cells, cell) * (cell_area(cell) - rest_cell_area(cell)) / rest_cell_area(cell);
         Real3 f{0, 0, 0};
         for (int s = offsets(i); s < offsets(i + 1); ++s) {
           const int t = corners(s) / 3, c = corners(s) % 3;
           double coef = global;
-          if constexpr (Local) coef += k_a * (area(t) - rest_area(t)) / rest_area(t);        // eq. 27
+          if constexpr (Local)
+            coef += cell_value(k_a_cells, cell) * (area(t) - rest_area(t)) / rest_area(t);   // eq. 27
           const Real3 edge = load3(x, tri(t, (c + 2) % 3)) - load3(x, tri(t, (c + 1) % 3));  // x_k - x_j
           f += (-0.5 * coef) * cross(load3(normal, t), edge);  // -coef dA_t/dx_i
         }
@@ -89,39 +91,43 @@ void add_area_forces_impl(const ExecutionSpace& space, const MeshBuffers<MemoryS
 
 // Adds the area-constraint forces (N) into force (n_nodes x 3). Either constant may be 0; both 0 is a
 // no-op. Needs update_geometry() (tri_area, tri_normal, cell_area) on the current mesh.x.
-template <class ExecutionSpace, class MemorySpace>
+// k_a, k_d: one value each (N/m) or PerCell tables (core/cell_params.hpp).
+template <class ExecutionSpace, class MemorySpace, class KA, class KD>
 void add_area_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                     const GeometryBuffers<MemorySpace>& geo, const AreaRest<MemorySpace>& rest, double k_a,
-                     double k_d, const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& force) {
-  if (k_a != 0 && k_d != 0)
+                     const GeometryBuffers<MemorySpace>& geo, const AreaRest<MemorySpace>& rest,
+                     const KA& k_a, const KD& k_d,
+                     const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& force) {
+  const bool local = any_nonzero(k_a), global = any_nonzero(k_d);
+  if (local && global)
     detail::add_area_forces_impl<true, true>(space, mesh, geo, rest, k_a, k_d, force);
-  else if (k_a != 0)
+  else if (local)
     detail::add_area_forces_impl<true, false>(space, mesh, geo, rest, k_a, k_d, force);
-  else if (k_d != 0)
+  else if (global)
     detail::add_area_forces_impl<false, true>(space, mesh, geo, rest, k_a, k_d, force);
 }
 
 // E_local + E_global (J), summed over all cells. Same geometry requirement as add_area_forces().
-template <class ExecutionSpace, class MemorySpace>
+template <class ExecutionSpace, class MemorySpace, class KA, class KD>
 double area_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                   const GeometryBuffers<MemorySpace>& geo, const AreaRest<MemorySpace>& rest, double k_a,
-                   double k_d) {
+                   const GeometryBuffers<MemorySpace>& geo, const AreaRest<MemorySpace>& rest, const KA& k_a,
+                   const KD& k_d) {
   const auto area = geo.tri_area;
+  const auto tri_cell = mesh.tri_cell;
   const auto cell_area = geo.cell_area;
   const auto rest_area = rest.tri_area;
   const auto rest_cell_area = rest.cell_area;
   double local = 0, global = 0;
-  if (k_a != 0)
+  if (any_nonzero(k_a))
     local = fixed_order_sum(
         "dcm::area::energy_local", space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) {
           const double d = area(t) - rest_area(t);
-          return 0.5 * k_a * d * d / rest_area(t);
+          return 0.5 * cell_value(k_a, tri_cell(t)) * d * d / rest_area(t);
         });
-  if (k_d != 0)
+  if (any_nonzero(k_d))
     global = fixed_order_sum(
         "dcm::area::energy_global", space, mesh.cell_sums, KOKKOS_LAMBDA(const int c) {
           const double d = cell_area(c) - rest_cell_area(c);
-          return 0.5 * k_d * d * d / rest_cell_area(c);
+          return 0.5 * cell_value(k_d, c) * d * d / rest_cell_area(c);
         });
   return local + global;
 }

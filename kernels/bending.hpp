@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "core/buffers.hpp"
+#include "core/cell_params.hpp"
 #include "core/vec3.hpp"
 
 namespace dcm {
@@ -138,9 +139,10 @@ void set_hinge_rest_angles(const HingeRest<MemorySpace>& rest, const std::vector
 
 // force(i) += bending forces on node i: one pass over the hinges (gradient, -M and cos(theta - theta*) into
 // rest), then a gather over the node's CSR (hinge, role) list of F_a = -M dtheta/dx_a (no atomics).
-template <class ExecutionSpace, class MemorySpace>
+// k_b: one value (J) or a PerCell table (core/cell_params.hpp).
+template <class ExecutionSpace, class MemorySpace, class KB>
 void add_bending_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                        const HingeRest<MemorySpace>& rest, double k_b,
+                        const HingeRest<MemorySpace>& rest, const KB& k_b,
                         const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& force) {
   const auto x = mesh.x;
   const auto hinge = mesh.hinge;
@@ -148,6 +150,7 @@ void add_bending_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpa
   const auto grad = rest.hinge_grad;
   const auto moment = rest.hinge_moment;
   const auto cos_delta = rest.hinge_cos_delta;
+  const auto hinge_cell = mesh.hinge_cell;
   Kokkos::parallel_for(
       "dcm::bending::hinges", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_hinges),
       KOKKOS_LAMBDA(const int h) {
@@ -156,7 +159,8 @@ void add_bending_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpa
         hinge_trig_gradient(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
                             load3(x, hinge(h, 3)), c, s, g);
         const double cr = rest_trig(h, 0), sr = rest_trig(h, 1);
-        moment(h) = -k_b * (s * cr - c * sr);  // -M = -k_b sin(theta - theta*), eq. 26
+        moment(h) =
+            -cell_value(k_b, hinge_cell(h)) * (s * cr - c * sr);  // -M = -k_b sin(theta - theta*), eq. 26
         cos_delta(h) = c * cr + s * sr;
         for (int a = 0; a < 4; ++a) {
           grad(h, a, 0) = g[a].x;
@@ -184,24 +188,26 @@ void add_bending_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpa
 }
 
 // The same forces, each hinge recomputed at each of its nodes (no scratch, one kernel).
-template <class ExecutionSpace, class MemorySpace>
+template <class ExecutionSpace, class MemorySpace, class KB>
 void add_bending_forces_per_node(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                                 const HingeRest<MemorySpace>& rest, double k_b,
+                                 const HingeRest<MemorySpace>& rest, const KB& k_b,
                                  const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& force) {
   const auto x = mesh.x;
   const auto hinge = mesh.hinge;
   const auto rest_trig = rest.rest_trig;
   const auto offsets = mesh.node_hinge_offsets;
   const auto roles = mesh.node_hinge_roles;
+  const auto node_cell = mesh.node_cell;
   Kokkos::parallel_for(
       "dcm::bending::per_node", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
+        const double kb = cell_value(k_b, node_cell(i));
         Real3 sum{0, 0, 0};
         for (int s = offsets(i); s < offsets(i + 1); ++s) {
           const int h = roles(s) / 4, a = roles(s) % 4;
           Real3 f[4];
           hinge_bending_forces(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
-                               load3(x, hinge(h, 3)), rest_trig(h, 0), rest_trig(h, 1), k_b, f);
+                               load3(x, hinge(h, 3)), rest_trig(h, 0), rest_trig(h, 1), kb, f);
           sum += f[a];
         }
         force(i, 0) += sum.x;
@@ -211,10 +217,11 @@ void add_bending_forces_per_node(const ExecutionSpace& space, const MeshBuffers<
 }
 
 // Total bending energy of all cells (J).
-template <class ExecutionSpace, class MemorySpace>
+template <class ExecutionSpace, class MemorySpace, class KB>
 double bending_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                      const HingeRest<MemorySpace>& rest, double k_b) {
+                      const HingeRest<MemorySpace>& rest, const KB& k_b) {
   const auto x = mesh.x;
+  const auto hinge_cell = mesh.hinge_cell;
   const auto hinge = mesh.hinge;
   const auto rest_trig = rest.rest_trig;
   return fixed_order_sum(
@@ -223,7 +230,8 @@ double bending_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace
         Real3 grad[4];
         hinge_trig_gradient(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
                             load3(x, hinge(h, 3)), c, s, grad);
-        return k_b * (1 - (c * rest_trig(h, 0) + s * rest_trig(h, 1)));  // 1 - cos(theta - theta*)
+        return cell_value(k_b, hinge_cell(h)) *
+               (1 - (c * rest_trig(h, 0) + s * rest_trig(h, 1)));  // 1 - cos(theta - theta*)
       });
 }
 

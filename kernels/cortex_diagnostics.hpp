@@ -29,10 +29,10 @@ struct NodeFields {
 };
 
 // Needs update_geometry() for the node normals and areas; force = the total conservative force per node.
-template <class ExecutionSpace, class MemorySpace>
+template <class ExecutionSpace, class MemorySpace, class Params>
 void compute_node_fields(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                          const GeometryBuffers<MemorySpace>& geo, const BondRest<MemorySpace>& rest,
-                         const FenePowParams& params,
+                         const Params& params,
                          const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& force,
                          const NodeFields<MemorySpace>& out) {
   const auto x = mesh.x;
@@ -42,11 +42,13 @@ void compute_node_fields(const ExecutionSpace& space, const MeshBuffers<MemorySp
   const auto rest_length = rest.rest_length;
   const auto normal = geo.node_normal;
   const auto area = geo.node_area;
-  const double k_s = params.k_s, x_max = params.x_max;
+  const auto node_cell = mesh.node_cell;
   const auto tension = out.tension, stretch = out.stretch, fn = out.normal_force, pn = out.normal_pressure;
   Kokkos::parallel_for(
       "dcm::fields::node", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
+        const FenePowParams pr = cell_value(params, node_cell(i));
+        const double k_s = pr.k_s, x_max = pr.x_max;
         double tau = 0, s = 0;
         const int nb = offsets(i + 1) - offsets(i);
         for (int k = offsets(i); k < offsets(i + 1); ++k) {

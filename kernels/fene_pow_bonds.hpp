@@ -21,6 +21,7 @@
 #include <limits>
 
 #include "core/buffers.hpp"
+#include "core/cell_params.hpp"
 #include "core/vec3.hpp"
 
 namespace dcm {
@@ -95,9 +96,10 @@ BondRest<MemorySpace> make_bond_rest(const ExecutionSpace& space, const MeshBuff
 
 // force(i) += sum over the bonds of node i of F_i (a gather over the node's CSR bond list: no atomics).
 // overstretched: set to -1 by the caller; receives the index of a bond that could not be evaluated.
-template <class ExecutionSpace, class MemorySpace>
+// params: one FenePowParams or a PerCell table of them (core/cell_params.hpp).
+template <class ExecutionSpace, class MemorySpace, class Params>
 void add_fene_pow_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                         const BondRest<MemorySpace>& rest, const FenePowParams& params,
+                         const BondRest<MemorySpace>& rest, const Params& params,
                          const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& force,
                          const Kokkos::View<int, MemorySpace>& overstretched) {
   const auto x = mesh.x;
@@ -105,11 +107,13 @@ void add_fene_pow_forces(const ExecutionSpace& space, const MeshBuffers<MemorySp
   const auto offsets = mesh.node_bond_offsets;
   const auto bonds = mesh.node_bonds;
   const auto rest_length = rest.rest_length;
-  const double k_s = params.k_s, x_max2 = params.x_max * params.x_max;
-  const double k_c_factor = k_s / (1 - 1 / x_max2);  // k_c = k_c_factor d*^3, eq. 24
+  const auto node_cell = mesh.node_cell;
   Kokkos::parallel_for(
       "dcm::bonds::fene_pow", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
+        const FenePowParams pr = cell_value(params, node_cell(i));
+        const double k_s = pr.k_s, x_max2 = pr.x_max * pr.x_max;
+        const double k_c_factor = k_s / (1 - 1 / x_max2);  // k_c = k_c_factor d*^3, eq. 24
         const Real3 p = load3(x, i);
         Real3 f{0, 0, 0};
         for (int s = offsets(i); s < offsets(i + 1); ++s) {
@@ -133,16 +137,18 @@ void add_fene_pow_forces(const ExecutionSpace& space, const MeshBuffers<MemorySp
 }
 
 // Total FENE + POW energy of all cells (J); +infinity if a bond cannot be evaluated.
-template <class ExecutionSpace, class MemorySpace>
+template <class ExecutionSpace, class MemorySpace, class Params>
 double fene_pow_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                       const BondRest<MemorySpace>& rest, const FenePowParams& params) {
+                       const BondRest<MemorySpace>& rest, const Params& params) {
   const auto x = mesh.x;
   const auto bond = mesh.bond;
+  const auto bond_cell = mesh.bond_cell;
   const auto rest_length = rest.rest_length;
-  const double k_s = params.k_s, x_max = params.x_max;
   const double infinity = std::numeric_limits<double>::infinity();
   return fixed_order_sum(
       "dcm::bonds::fene_pow_energy", space, mesh.bond_sums, KOKKOS_LAMBDA(const int b) {
+        const FenePowParams pr = cell_value(params, bond_cell(b));
+        const double k_s = pr.k_s, x_max = pr.x_max;
         const double d = norm(load3(x, bond(b, 0)) - load3(x, bond(b, 1))), d_rest = rest_length(b);
         return fene_pow_bond_ok(d, d_rest, x_max) ? fene_pow_bond_energy(d, d_rest, k_s, x_max) : infinity;
       });

@@ -11,6 +11,7 @@
 //   distribution to the three nodes by the 3×3 solve of eq. 19 (kernels/contact_distribution.hpp).
 // The per-triangle results are kept (node loads, β weights for the substrate friction, contact area) and
 // gathered per node without atomics through the node → triangle-corner lists.
+#include "core/cell_params.hpp"
 #include "core/geometry.hpp"
 #include "core/vec3.hpp"
 #include "kernels/contact_distribution.hpp"
@@ -103,10 +104,11 @@ KOKKOS_INLINE_FUNCTION Real3 nearest_point_in_triangle(Real3 p0, Real3 p1, Real3
 }
 
 // Per-triangle contact with the plane (needs update_geometry(): tri_area, tri_normal, the spheres).
-template <class ExecutionSpace, class MemorySpace>
+// params: one PlaneContactParams or a PerCell table of them (core/cell_params.hpp).
+template <class ExecutionSpace, class MemorySpace, class Params>
 void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                           const GeometryBuffers<MemorySpace>& geo, const Plane& plane,
-                           const PlaneContactParams& params, const ContactBuffers<MemorySpace>& out) {
+                           const GeometryBuffers<MemorySpace>& geo, const Plane& plane, const Params& params,
+                           const ContactBuffers<MemorySpace>& out) {
   const auto x = mesh.x;
   const auto tri = mesh.tri;
   const auto tri_area = geo.tri_area;
@@ -121,7 +123,7 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
   const auto regime = out.tri_regime;
   const double len = norm(plane.normal);
   const Real3 n = (1.0 / len) * plane.normal, p_plane = plane.point;
-  const PlaneContactParams prm = params;
+  const auto tri_cell = mesh.tri_cell;
   Kokkos::parallel_for(
       "dcm::contact::plane", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_tris),
       KOKKOS_LAMBDA(const int t) {
@@ -133,6 +135,7 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
         friction_area(t) = 0;
         load(t) = 0;
         regime(t) = kNoContact;
+        const PlaneContactParams prm = cell_value(params, tri_cell(t));
         const Real3 x0 = load3(x, tri(t, 0)), x1 = load3(x, tri(t, 1)), x2 = load3(x, tri(t, 2));
         const double R = radius(t);
         const Real3 O = load3(center, t);

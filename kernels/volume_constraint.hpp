@@ -23,6 +23,7 @@
 // Expectations (tests/test_constraints.cpp): forces = -grad E by central differences (relative error
 // < 1e-6); zero at the rest shape; zero net force and torque; a uniformly scaled icosphere gets
 // restoring radial forces, sum_i x_i . F_i = -3 k_v (V - V*) V / V* (V is homogeneous of degree 3).
+#include "core/cell_params.hpp"
 #include "core/geometry.hpp"
 #include "core/vec3.hpp"
 #include "kernels/rest_state.hpp"
@@ -50,11 +51,13 @@ VolumeRest<MemorySpace> make_volume_rest(const ExecutionSpace& space, const Mesh
 
 // Adds the volume-constraint forces (N) into force (n_nodes x 3); k_v = 0 is a no-op. Needs
 // update_geometry() (tri_area, tri_normal, cell_volume) on the current mesh.x.
-template <class ExecutionSpace, class MemorySpace>
+// k_v: one value (Pa) or a PerCell table (core/cell_params.hpp).
+template <class ExecutionSpace, class MemorySpace, class KV>
 void add_volume_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                        const GeometryBuffers<MemorySpace>& geo, const VolumeRest<MemorySpace>& rest,
-                       double k_v, const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& force) {
-  if (k_v == 0) return;
+                       const KV& k_v_cells,
+                       const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& force) {
+  if (!any_nonzero(k_v_cells)) return;
   const auto node_cell = mesh.node_cell;
   const auto offsets = mesh.node_tri_offsets;
   const auto corners = mesh.node_tri_corners;
@@ -67,7 +70,7 @@ void add_volume_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpac
       KOKKOS_LAMBDA(const int i) {
         const int c = node_cell(i);
         // eq. 29 as a gradient: -k_v (V - V*) / V* dV/dx_i
-        const double coef = -k_v * (volume(c) - rest_volume(c)) / rest_volume(c) / 3.0;
+        const double coef = -cell_value(k_v_cells, c) * (volume(c) - rest_volume(c)) / rest_volume(c) / 3.0;
         Real3 an{0, 0, 0};  // sum_t A_t n_t
         for (int s = offsets(i); s < offsets(i + 1); ++s) {
           const int t = corners(s) / 3;
@@ -80,16 +83,16 @@ void add_volume_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpac
 }
 
 // E_vol (J), summed over all cells. Same geometry requirement as add_volume_forces().
-template <class ExecutionSpace, class MemorySpace>
+template <class ExecutionSpace, class MemorySpace, class KV>
 double volume_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                      const GeometryBuffers<MemorySpace>& geo, const VolumeRest<MemorySpace>& rest,
-                     double k_v) {
+                     const KV& k_v) {
   const auto volume = geo.cell_volume;
   const auto rest_volume = rest.cell_volume;
   return fixed_order_sum(
       "dcm::volume::energy", space, mesh.cell_sums, KOKKOS_LAMBDA(const int c) {
         const double d = volume(c) - rest_volume(c);
-        return 0.5 * k_v * d * d / rest_volume(c);
+        return 0.5 * cell_value(k_v, c) * d * d / rest_volume(c);
       });
 }
 

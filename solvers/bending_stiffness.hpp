@@ -7,6 +7,8 @@
 // (s_h = Δt k_b max(cos, 0) ∇θ_h · v) and a gather over the node's hinges (no atomics). ∇θ_h and cos(θ_h −
 // θ*_h) are those the bending force pass of the same positions left in HingeRest (kernels/bending.hpp): like
 // the forces, the stiffness belongs to the positions of the last compute_forces().
+#include <vector>
+
 #include "kernels/bending.hpp"
 
 namespace dcm {
@@ -14,17 +16,28 @@ namespace dcm {
 template <class MemorySpace>
 struct BendingStiffness {
   Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> s;  // per hinge scratch: Δt k_b max(cos, 0) ∇θ · v
-  double dt_k_b = 0;                                          // Δt k_b of the current step (J·s)
+  // Δt k_b of the current step per cell (J·s)
+  Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> dt_k_b;
+  typename Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace>::HostMirror dt_k_b_host;
   BendingStiffness() = default;
   explicit BendingStiffness(const MeshBuffers<MemorySpace>& mesh)
-      : s("dcm::bending_stiffness::s", mesh.n_hinges) {}
+      : s("dcm::bending_stiffness::s", mesh.n_hinges),
+        dt_k_b("dcm::bending_stiffness::dt_k_b", mesh.n_cells),
+        dt_k_b_host(Kokkos::create_mirror_view(dt_k_b)) {}
 };
 
 // The stiffness of a step dt; ∇θ and cos(θ − θ*) come from the last add_bending_forces()
 // (kernels/bending.hpp).
+// k_b: the bending constant of every cell (J), one entry per cell (or one for all).
+template <class MemorySpace>
+void update_bending_stiffness(const std::vector<double>& k_b, double dt, BendingStiffness<MemorySpace>& bs) {
+  for (std::size_t c = 0; c < bs.dt_k_b_host.extent(0); ++c)
+    bs.dt_k_b_host(c) = dt * k_b[k_b.size() == 1 ? 0 : c];
+  Kokkos::deep_copy(bs.dt_k_b, bs.dt_k_b_host);
+}
 template <class MemorySpace>
 void update_bending_stiffness(double k_b, double dt, BendingStiffness<MemorySpace>& bs) {
-  bs.dt_k_b = dt * k_b;
+  update_bending_stiffness(std::vector<double>{k_b}, dt, bs);
 }
 
 // out += Δt K_bend v.
@@ -37,7 +50,8 @@ void apply_bending_stiffness(const ExecutionSpace& space, const MeshBuffers<Memo
   const auto g = hinges.hinge_grad;
   const auto cos_delta = hinges.hinge_cos_delta;
   const auto s = bs.s;
-  const double dt_k_b = bs.dt_k_b;
+  const auto dt_k_b = bs.dt_k_b;
+  const auto hinge_cell = mesh.hinge_cell;
   Kokkos::parallel_for(
       "dcm::bending_stiffness::project", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_hinges),
       KOKKOS_LAMBDA(const int h) {
@@ -46,7 +60,7 @@ void apply_bending_stiffness(const ExecutionSpace& space, const MeshBuffers<Memo
           const int i = hinge(h, a);
           sum += g(h, a, 0) * v(i, 0) + g(h, a, 1) * v(i, 1) + g(h, a, 2) * v(i, 2);
         }
-        s(h) = dt_k_b * math::max(cos_delta(h), 0.0) * sum;
+        s(h) = dt_k_b(hinge_cell(h)) * math::max(cos_delta(h), 0.0) * sum;
       });
   const auto offsets = mesh.node_hinge_offsets;
   const auto roles = mesh.node_hinge_roles;

@@ -66,6 +66,46 @@ struct MechanicsParams {
       true;  // substrate friction w_i Γ_t per node (false: β_i β_j Γ_t), friction_operator.hpp
 };
 
+// Why cells with parameters a and b cannot share the buffers of one batch ("" if they can): what decides
+// which terms, kernels and solver options exist must agree; the constants themselves may differ.
+inline std::string batch_mismatch(const MechanicsParams& a, const MechanicsParams& b) {
+  auto on = [](double k) { return k != 0; };
+  struct Switch {
+    const char* name;
+    bool differs;
+  };
+  const Switch checks[] = {
+      {"bonds on/off (k_s = 0)", on(a.bonds.k_s) != on(b.bonds.k_s)},
+      {"bending on/off (k_b = 0)", on(a.k_b) != on(b.k_b)},
+      {"local area term on/off", on(a.k_area_local) != on(b.k_area_local)},
+      {"global area term on/off", on(a.k_area_global) != on(b.k_area_global)},
+      {"volume term on/off", on(a.k_volume) != on(b.k_volume)},
+      {"dashpots on/off",
+       on(a.dashpot) != on(b.dashpot) || on(a.dashpot_transverse) != on(b.dashpot_transverse)},
+      {"the curvature clamp h_min", a.h_min != b.h_min},
+      {"the preconditioner (multigrid)", a.multigrid != b.multigrid},
+      {"the implicit terms", a.implicit_bonds != b.implicit_bonds ||
+                                 a.implicit_bending != b.implicit_bending ||
+                                 a.implicit_tension != b.implicit_tension},
+      {"gravity on/off", on(a.gravity * a.density_excess) != on(b.gravity * b.density_excess)},
+      {"the plane",
+       a.has_plane != b.has_plane ||
+           (a.has_plane && (a.plane.point.x != b.plane.point.x || a.plane.point.y != b.plane.point.y ||
+                            a.plane.point.z != b.plane.point.z || a.plane.normal.x != b.plane.normal.x ||
+                            a.plane.normal.y != b.plane.normal.y || a.plane.normal.z != b.plane.normal.z))},
+      {"the contact integration (quadrature points, projected area, friction zone)",
+       a.contact.quadrature_points != b.contact.quadrature_points ||
+           a.contact.projected_area != b.contact.projected_area ||
+           a.contact.friction_on_adhesive_zone != b.contact.friction_on_adhesive_zone},
+      {"substrate friction on/off", on(a.gamma_n) != on(b.gamma_n) || on(a.gamma_t) != on(b.gamma_t) ||
+                                        on(a.pin_friction) != on(b.pin_friction)},
+      {"lumped substrate friction", a.lumped_friction != b.lumped_friction},
+  };
+  for (const Switch& s : checks)
+    if (s.differs) return std::string("they differ in ") + s.name;
+  return "";
+}
+
 // Index of the first node with a non-finite component, or -1.
 template <class ExecutionSpace, class Vector>
 int first_non_finite_node(const ExecutionSpace& space, const Vector& v) {
@@ -89,15 +129,24 @@ class CortexModel {
 
   // The rest state of every term is the shape the cells are given in.
   CortexModel(const ExecutionSpace& space, const std::vector<HostCell>& cells, const MechanicsParams& p)
+      : CortexModel(space, cells, std::vector<MechanicsParams>(cells.size(), p)) {}
+  // A batch: cell c with the constants cell_params[c] (the batched engine, docs/SCANS.md). The constants may
+  // differ from cell to cell; what decides which terms and kernels exist must not (batch_mismatch()).
+  // Each cell then computes exactly what it computes alone.
+  CortexModel(const ExecutionSpace& space, const std::vector<HostCell>& cells,
+              const std::vector<MechanicsParams>& cell_params)
       : space_(space),
-        params_(p),
+        params_(checked_batch(cells, cell_params)),
+        cell_params_(cell_params),
         mesh_(upload_cells<Mem>(cells)),
         geo_(mesh_),
         force_(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::model::force"), mesh_.n_nodes),
         velocity_("dcm::model::velocity", mesh_.n_nodes),
         external_("dcm::model::external_force", mesh_.n_nodes),
         overstretched_("dcm::model::overstretched"),
-        cg_(mesh_.n_nodes) {
+        cg_(mesh_.host_cell_node_begin) {
+    const MechanicsParams& p = params_;
+    make_cell_tables();
     update_geometry(space_, mesh_, geo_, p.h_min);
     if (p.bonds.k_s > 0) bonds_ = make_bond_rest(space_, mesh_);
     if (p.k_b > 0) hinges_ = make_hinge_rest(space_, mesh_);
@@ -115,6 +164,8 @@ class CortexModel {
         enable_substrate_friction(friction_, *contact_, p.gamma_n, p.gamma_t, p.plane.normal, p.pin_friction,
                                   p.lumped_friction);
     }
+    for (const MechanicsParams& q : cell_params_)
+      friction_.cell_rows.push_back({q.dashpot, q.dashpot_transverse, q.gamma_n, q.gamma_t, q.pin_friction});
     if (p.multigrid && (p.dashpot > 0 || p.dashpot_transverse > 0)) {
       multigrid_ = make_multigrid(cells, mesh_);
       if (!multigrid_->available) multigrid_.reset();  // no hierarchy: block-Jacobi
@@ -123,20 +174,24 @@ class CortexModel {
 
   const MeshBuffers<Mem>& mesh() const { return mesh_; }
   const GeometryBuffers<Mem>& geometry() const { return geo_; }
-  const MechanicsParams& params() const { return params_; }
+  const MechanicsParams& params() const { return params_; }  // cell 0's (structure: the same for all)
+  const MechanicsParams& cell_params(int c) const { return cell_params_.at(c); }
+  int n_cells() const { return mesh_.n_cells; }
   const Vector& positions() const { return mesh_.x; }
   const Vector& force() const { return force_; }
   const Vector& velocity() const { return velocity_; }
   const Vector& external_force() const { return external_; }  // set by the caller; zero at start
   const ExecutionSpace& space() const { return space_; }
   const FrictionOperator<Mem>& friction() const { return friction_; }
+  // Each cell's part of the last velocity solve (iterations, residual, convergence): the CG is per cell.
+  const std::vector<CgResult>& cell_solves() const { return cg_.segment_results; }
   // Per-triangle contact results of the last compute_forces() (empty without a plane).
   const std::optional<ContactBuffers<Mem>>& contact() const { return contact_; }
   // Per-node tension (eq. 1), stretch, normal force and pressure of the current state (compute_forces()
   // first); needs the bond term.
   void node_fields(const NodeFields<Mem>& out) const {
     if (!bonds_) throw std::logic_error("node_fields() needs the FENE+POW bond term");
-    compute_node_fields(space_, mesh_, geo_, *bonds_, params_.bonds, force_, out);
+    compute_node_fields(space_, mesh_, geo_, *bonds_, bond_params_, force_, out);
   }
   // The state a step starts from: positions and the last velocity (the warm start of the next solve). The
   // rest states, parameters and external forces are not saved: they come from the scene.
@@ -169,11 +224,13 @@ class CortexModel {
     const auto x = mesh_.x;
     const auto bond = mesh_.bond;
     const auto rest = bonds_->rest_length;
-    const double x_max = params_.bonds.x_max;
+    const auto bond_cell = mesh_.bond_cell;
+    const auto table = bond_params_;
     double m = 0;
     Kokkos::parallel_reduce(
         "dcm::model::max_bond_extension", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_bonds),
         KOKKOS_LAMBDA(const int b, double& a) {
+          const double x_max = cell_value(table, bond_cell(b)).x_max;
           const double e = norm(load3(x, bond(b, 1)) - load3(x, bond(b, 0))) / (x_max * rest(b));
           if (!(e <= a)) a = e;  // NaN propagates as "not below"
         },
@@ -196,19 +253,18 @@ class CortexModel {
     Kokkos::deep_copy(space_, force_, 0.0);
     if (bonds_) {
       Kokkos::deep_copy(space_, overstretched_, -1);
-      add_fene_pow_forces(space_, mesh_, *bonds_, params_.bonds, force_, overstretched_);
+      add_fene_pow_forces(space_, mesh_, *bonds_, bond_params_, force_, overstretched_);
       int bad = -1;
       Kokkos::deep_copy(bad, overstretched_);
       if (bad >= 0) throw NumericalError(describe_overstretch(bad));
     }
-    if (hinges_) add_bending_forces(space_, mesh_, *hinges_, params_.k_b, force_);
-    if (area_)
-      add_area_forces(space_, mesh_, geo_, *area_, params_.k_area_local, params_.k_area_global, force_);
-    if (volume_) add_volume_forces(space_, mesh_, geo_, *volume_, params_.k_volume, force_);
+    if (hinges_) add_bending_forces(space_, mesh_, *hinges_, k_b_, force_);
+    if (area_) add_area_forces(space_, mesh_, geo_, *area_, k_area_local_, k_area_global_, force_);
+    if (volume_) add_volume_forces(space_, mesh_, geo_, *volume_, k_volume_, force_);
     add_external_forces(space_, external_, force_);
     if (gravity_) add_external_forces(space_, *gravity_, force_);
     if (contact_) {
-      compute_plane_contact(space_, mesh_, geo_, params_.plane, params_.contact, *contact_);
+      compute_plane_contact(space_, mesh_, geo_, params_.plane, contact_params_, *contact_);
       add_plane_contact_forces(space_, mesh_, params_.plane, *contact_, force_);
     }
     const int bad_node = first_non_finite_node(space_, force_);
@@ -222,10 +278,10 @@ class CortexModel {
     update_geometry(space_, mesh_, geo_, params_.h_min);
     double e = external_energy(space_, mesh_.node_sums, external_, mesh_.x);
     if (gravity_) e += external_energy(space_, mesh_.node_sums, *gravity_, mesh_.x);
-    if (bonds_) e += fene_pow_energy(space_, mesh_, *bonds_, params_.bonds);
-    if (hinges_) e += bending_energy(space_, mesh_, *hinges_, params_.k_b);
-    if (area_) e += area_energy(space_, mesh_, geo_, *area_, params_.k_area_local, params_.k_area_global);
-    if (volume_) e += volume_energy(space_, mesh_, geo_, *volume_, params_.k_volume);
+    if (bonds_) e += fene_pow_energy(space_, mesh_, *bonds_, bond_params_);
+    if (hinges_) e += bending_energy(space_, mesh_, *hinges_, k_b_);
+    if (area_) e += area_energy(space_, mesh_, geo_, *area_, k_area_local_, k_area_global_);
+    if (volume_) e += volume_energy(space_, mesh_, geo_, *volume_, k_volume_);
     return e;
   }
 
@@ -249,10 +305,13 @@ class CortexModel {
       const auto bond = mesh_.bond;
       const auto rest = bonds_->rest_length;
       const auto k_dt = friction_.bond_stiffness_dt;
-      const double k_s = params_.bonds.k_s, x_max = params_.bonds.x_max;
+      const auto bond_cell = mesh_.bond_cell;
+      const auto table = bond_params_;
       Kokkos::parallel_for(
           "dcm::model::implicit_bonds", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_bonds),
           KOKKOS_LAMBDA(const int b) {
+            const FenePowParams pr = cell_value(table, bond_cell(b));
+            const double k_s = pr.k_s, x_max = pr.x_max;
             const double d = norm(load3(x, bond(b, 1)) - load3(x, bond(b, 0)));
             k_dt(b) = dt * fene_pow_implicit_stiffness(d, rest(b), k_s, x_max);
           });
@@ -262,7 +321,7 @@ class CortexModel {
     update_friction(space_, mesh_, friction_);
     const bool implicit_tension = dt > 0 && tension_stiffness_.has_value();
     if (implicit_tension)
-      update_tension_stiffness(space_, mesh_, geo_, *area_, params_.k_area_local, params_.k_area_global, dt,
+      update_tension_stiffness(space_, mesh_, geo_, *area_, k_area_local_, k_area_global_, dt,
                                *tension_stiffness_);
     // The multigrid's fine level holds Γ, the implicit bonds and the implicit tension (same sparsity).
     if (multigrid_) {
@@ -277,11 +336,11 @@ class CortexModel {
     const bool implicit = dt > 0 && global_.has_value();
     const bool implicit_bending = dt > 0 && bending_stiffness_.has_value();
     if (implicit_bending)
-      update_bending_stiffness(params_.k_b, dt, *bending_stiffness_);  // ∇θ from compute_forces()
+      update_bending_stiffness(k_b_.host, dt, *bending_stiffness_);  // ∇θ from compute_forces()
     if (implicit)
       update_global_stiffness(space_, mesh_, geo_, area_ ? area_->cell_area : volume_->cell_volume,
-                              volume_ ? volume_->cell_volume : area_->cell_area, params_.k_area_global,
-                              params_.k_volume, dt, *global_);
+                              volume_ ? volume_->cell_volume : area_->cell_area, k_area_global_, k_volume_,
+                              dt, *global_);
     if (params_.dashpot == 0 && params_.dashpot_transverse == 0 && !friction_.substrate && !implicit &&
         !implicit_bending && !implicit_bonds && !implicit_tension) {
       apply_block_jacobi(space_, friction_, force_, velocity_);
@@ -386,7 +445,7 @@ class CortexModel {
     int i = 0;
     for (std::size_t c = 0; c < cells.size(); ++c) {
       const int n = static_cast<int>(cells[c].mesh.nodes.size());
-      const double per_node = params_.density_excess * volume[c] * params_.gravity / n;
+      const double per_node = cell_params_[c].density_excess * volume[c] * cell_params_[c].gravity / n;
       for (int k = 0; k < n; ++k, ++i) h(i, 2) = -per_node;
     }
     Kokkos::deep_copy(w, h);
@@ -402,7 +461,7 @@ class CortexModel {
     for (std::size_t c = 0; c < cells.size(); ++c) {
       const int n = static_cast<int>(cells[c].mesh.nodes.size());
       const double r = std::sqrt(area[c] / (4 * pi));
-      for (int k = 0; k < n; ++k) h(i++) = 6 * pi * params_.viscosity * r / n;
+      for (int k = 0; k < n; ++k) h(i++) = 6 * pi * cell_params_[c].viscosity * r / n;
     }
     Kokkos::deep_copy(drag, h);
     return drag;
@@ -421,20 +480,18 @@ class CortexModel {
     };
     std::string t;
     if (bonds_ && (t = check("FENE+POW bonds", [&] {
-                     add_fene_pow_forces(space_, mesh_, *bonds_, params_.bonds, scratch, overstretched_);
+                     add_fene_pow_forces(space_, mesh_, *bonds_, bond_params_, scratch, overstretched_);
                    })) != "")
       return t;
-    if (hinges_ && (t = check("bending", [&] {
-                      add_bending_forces(space_, mesh_, *hinges_, params_.k_b, scratch);
-                    })) != "")
+    if (hinges_ &&
+        (t = check("bending", [&] { add_bending_forces(space_, mesh_, *hinges_, k_b_, scratch); })) != "")
       return t;
     if (area_ && (t = check("area constraints", [&] {
-                    add_area_forces(space_, mesh_, geo_, *area_, params_.k_area_local, params_.k_area_global,
-                                    scratch);
+                    add_area_forces(space_, mesh_, geo_, *area_, k_area_local_, k_area_global_, scratch);
                   })) != "")
       return t;
     if (volume_ && (t = check("volume constraint", [&] {
-                      add_volume_forces(space_, mesh_, geo_, *volume_, params_.k_volume, scratch);
+                      add_volume_forces(space_, mesh_, geo_, *volume_, k_volume_, scratch);
                     })) != "")
       return t;
     if (contact_ && (t = check("plane contact", [&] {
@@ -446,14 +503,43 @@ class CortexModel {
 
   std::string describe_overstretch(int bond) const {
     auto b = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh_.bond);
+    auto cell = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh_.bond_cell);
     return "FENE bond " + std::to_string(bond) + " (nodes " + std::to_string(b(bond, 0)) + "-" +
-           std::to_string(b(bond, 1)) +
-           ") reached its maximum length d_max = x_max d* (x_max = " + std::to_string(params_.bonds.x_max) +
-           "); reduce the time step or the load";
+           std::to_string(b(bond, 1)) + (mesh_.n_cells > 1 ? ", cell " + std::to_string(cell(bond)) : "") +
+           ") reached its maximum length d_max = x_max d* (x_max = " +
+           std::to_string(cell_params_.at(cell(bond)).bonds.x_max) + "); reduce the time step or the load";
+  }
+
+  // The per-cell constant tables the kernels read (core/cell_params.hpp).
+  void make_cell_tables() {
+    bond_params_ = member_table<Mem>(cell_params_, &MechanicsParams::bonds, "dcm::model::bond_params");
+    k_b_ = member_table<Mem>(cell_params_, &MechanicsParams::k_b, "dcm::model::k_b");
+    k_area_local_ = member_table<Mem>(cell_params_, &MechanicsParams::k_area_local, "dcm::model::k_a");
+    k_area_global_ = member_table<Mem>(cell_params_, &MechanicsParams::k_area_global, "dcm::model::k_d");
+    k_volume_ = member_table<Mem>(cell_params_, &MechanicsParams::k_volume, "dcm::model::k_v");
+    contact_params_ = member_table<Mem>(cell_params_, &MechanicsParams::contact, "dcm::model::contact");
+  }
+
+  // Cell 0's parameters, after checking that every cell has the same structure (batch_mismatch()).
+  static MechanicsParams checked_batch(const std::vector<HostCell>& cells,
+                                       const std::vector<MechanicsParams>& p) {
+    if (p.empty() || p.size() != cells.size())
+      throw std::invalid_argument("CortexModel: " + std::to_string(p.size()) + " parameter sets for " +
+                                  std::to_string(cells.size()) + " cells");
+    for (std::size_t c = 1; c < p.size(); ++c) {
+      const std::string what = batch_mismatch(p[0], p[c]);
+      if (!what.empty())
+        throw std::invalid_argument("cells 0 and " + std::to_string(c) + " cannot share a batch: " + what);
+    }
+    return p[0];
   }
 
   ExecutionSpace space_;
-  MechanicsParams params_;
+  MechanicsParams params_;                    // cell 0's
+  std::vector<MechanicsParams> cell_params_;  // every cell's
+  PerCell<FenePowParams, Mem> bond_params_;
+  PerCell<double, Mem> k_b_, k_area_local_, k_area_global_, k_volume_;
+  PerCell<PlaneContactParams, Mem> contact_params_;
   MeshBuffers<Mem> mesh_;
   GeometryBuffers<Mem> geo_;
   Vector force_, velocity_, external_;

@@ -21,6 +21,9 @@
 // are cached once per step by update(); apply() is a gather over each node's bonds (no atomics).
 // Expectations (tests/test_solver.cpp): symmetric (uᵀΓw = wᵀΓu) and positive (vᵀΓv > 0) on random
 // vectors; Γ·v for a rigid translation is ζ v; matches an assembled Eigen matrix.
+#include <array>
+#include <vector>
+
 #include "core/buffers.hpp"
 #include "core/vec3.hpp"
 #include "kernels/plane_contact.hpp"
@@ -54,6 +57,12 @@ struct FrictionOperator {
   double pin_friction = 0;  // N·s/m; 0: off
   View<int*> tri_regime;    // ContactRegime per triangle (shared with the contact buffers)
 
+  // The coefficients the kernels read, per cell: c, c_t, γ_n, γ_t, pin (FrictionCoef). update_friction()
+  // fills them from the scalars above, or from cell_rows when set (a batch of cells with different
+  // constants: core/cell_params.hpp); Γ has no coupling between cells either way.
+  View<double* [5]> cell_coef;
+  std::vector<std::array<double, 5>> cell_rows;
+
   FrictionOperator() = default;
   FrictionOperator(const MeshBuffers<MemorySpace>& mesh, View<double*> drag, double c, double c_t = 0)
       : node_drag(drag),
@@ -61,8 +70,24 @@ struct FrictionOperator {
         dashpot_transverse(c_t),
         bond_dir(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::friction::bond_dir"), mesh.n_bonds),
         block_inverse(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::friction::block_inverse"),
-                      mesh.n_nodes) {}
+                      mesh.n_nodes),
+        cell_coef("dcm::friction::cell_coef", mesh.n_cells) {}
 };
+
+enum FrictionCoef : int { kDashpot = 0, kDashpotTransverse = 1, kGammaN = 2, kGammaT = 3, kPin = 4 };
+
+// Fills op.cell_coef (from cell_rows, or the scalars for every cell).
+template <class MemorySpace>
+void sync_friction_coefficients(const FrictionOperator<MemorySpace>& op) {
+  auto h = Kokkos::create_mirror_view(op.cell_coef);
+  for (std::size_t c = 0; c < h.extent(0); ++c) {
+    const std::array<double, 5> uniform{op.dashpot, op.dashpot_transverse, op.gamma_n, op.gamma_t,
+                                        op.pin_friction};
+    const std::array<double, 5>& row = op.cell_rows.empty() ? uniform : op.cell_rows.at(c);
+    for (int k = 0; k < 5; ++k) h(c, k) = row[k];
+  }
+  Kokkos::deep_copy(op.cell_coef, h);
+}
 
 // Switches the substrate blocks on; beta and area are read at every update()/apply() (the contact kernel
 // refreshes them each step).
@@ -144,7 +169,8 @@ struct SubstrateBlocks {
   template <class T>
   using View = Kokkos::View<T, Kokkos::LayoutRight, MemorySpace>;
   bool on = false, lumped = false;
-  double gamma_n = 0, gamma_t = 0, pin = 0;
+  View<double* [5]> coef;  // per cell (FrictionCoef)
+  View<int*> node_cell;
   Real3 normal{0, 0, 1};
   View<int* [3]> tri;
   View<int*> tri_offsets, corners, regime;
@@ -153,6 +179,8 @@ struct SubstrateBlocks {
 
   KOKKOS_INLINE_FUNCTION void add_block(int i, int j, double blk[6]) const {
     if (!on || (lumped && i != j)) return;  // lumped: diagonal blocks only
+    const int cell = node_cell(i);
+    const double gamma_n = coef(cell, kGammaN), gamma_t = coef(cell, kGammaT), pin = coef(cell, kPin);
     for (int q = tri_offsets(i); q < tri_offsets(i + 1); ++q) {
       const int t = corners(q) / 3;
       const double a = area(t);
@@ -184,9 +212,8 @@ SubstrateBlocks<MemorySpace> substrate_blocks(const MeshBuffers<MemorySpace>& me
   SubstrateBlocks<MemorySpace> s;
   s.on = op.substrate;
   s.lumped = op.substrate_lumped;
-  s.gamma_n = op.gamma_n;
-  s.gamma_t = op.gamma_t;
-  s.pin = op.pin_friction;
+  s.coef = op.cell_coef;
+  s.node_cell = mesh.node_cell;
   s.normal = op.substrate_normal;
   s.tri = mesh.tri;
   s.tri_offsets = mesh.node_tri_offsets;
@@ -201,6 +228,7 @@ SubstrateBlocks<MemorySpace> substrate_blocks(const MeshBuffers<MemorySpace>& me
 template <class ExecutionSpace, class MemorySpace>
 void update_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                      const FrictionOperator<MemorySpace>& op) {
+  sync_friction_coefficients(op);
   const auto x = mesh.x;
   const auto bond = mesh.bond;
   const auto dir = op.bond_dir;
@@ -215,13 +243,15 @@ void update_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>
   const auto bonds = mesh.node_bonds;
   const auto drag = op.node_drag;
   const auto inverse = op.block_inverse;
-  const double c = op.dashpot, c_t = op.dashpot_transverse;
+  const auto coef = op.cell_coef;
+  const auto node_cell = mesh.node_cell;
   const auto substrate = substrate_blocks(mesh, op);
   const auto bond_k = op.bond_stiffness_dt;
   const bool stiff = bond_k.extent(0) > 0;
   Kokkos::parallel_for(
       "dcm::friction::block_jacobi", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
+        const double c = coef(node_cell(i), kDashpot), c_t = coef(node_cell(i), kDashpotTransverse);
         double a[6] = {drag(i), drag(i), drag(i), 0, 0, 0};
         for (int s = offsets(i); s < offsets(i + 1); ++s)
           add_dashpot_block(load3(dir, bonds(s)), c + (stiff ? bond_k(bonds(s)) : 0.0), c_t, 1.0, a);
@@ -243,18 +273,18 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
   const auto bonds = mesh.node_bonds;
   const auto dir = op.bond_dir;
   const auto drag = op.node_drag;
-  const double c = op.dashpot, c_t = op.dashpot_transverse;
+  const auto coef = op.cell_coef;
+  const auto node_cell = mesh.node_cell;
+  const auto tri_cell = mesh.tri_cell;
   const bool substrate = op.substrate, lumped = op.substrate_lumped;
   const auto tri_offsets = mesh.node_tri_offsets;
   const auto corners = mesh.node_tri_corners;
   const auto beta = op.tri_beta;
   const auto scratch = op.tri_scratch;
-  const double pin = op.pin_friction;
   const auto regime = op.tri_regime;
   const auto bond_k = op.bond_stiffness_dt;
   const bool stiff = bond_k.extent(0) > 0;
   const auto contact_area = op.tri_contact_area;
-  const double gamma_n = op.gamma_n, gamma_t = op.gamma_t;
   const Real3 sn = op.substrate_normal;
   if (substrate && !lumped) {  // u_t = Γ_t Σ_j β_tj v_j for the triangles in contact
     const auto tri = mesh.tri;
@@ -265,7 +295,8 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
           Real3 u{0, 0, 0};
           if (area > 0) {
             for (int k = 0; k < 3; ++k) u += beta(t, k) * load3(v, tri(t, k));
-            u = substrate_block_times(sn, area, gamma_n, gamma_t, u);
+            const int cell = tri_cell(t);
+            u = substrate_block_times(sn, area, coef(cell, kGammaN), coef(cell, kGammaT), u);
           }
           store3(scratch, t, u);
         });
@@ -273,6 +304,8 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
   Kokkos::parallel_for(
       "dcm::friction::apply", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
+        const int cell = node_cell(i);
+        const double c = coef(cell, kDashpot), c_t = coef(cell, kDashpotTransverse);
         const Real3 vi = load3(v, i);
         Real3 acc = drag(i) * vi;
         for (int s = offsets(i); s < offsets(i + 1); ++s) {
@@ -288,8 +321,8 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
             const int t = corners(k) / 3;
             const double area = contact_area(t);
             if (area > 0)
-              acc += substrate_block_times(sn, lumped_weight(beta, t, corners(k) % 3) * area, gamma_n,
-                                           gamma_t, vi);
+              acc += substrate_block_times(sn, lumped_weight(beta, t, corners(k) % 3) * area,
+                                           coef(cell, kGammaN), coef(cell, kGammaT), vi);
           }
         } else if (substrate) {
           for (int k = tri_offsets(i); k < tri_offsets(i + 1); ++k) {
@@ -297,6 +330,7 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
             acc += beta(t, corners(k) % 3) * load3(scratch, t);
           }
         }
+        const double pin = coef(cell, kPin);
         if (pin > 0 && node_fully_in_contact(i, tri_offsets, corners, regime)) acc += pin * vi;
         store3(out, i, acc);
       });

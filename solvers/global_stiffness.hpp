@@ -8,6 +8,7 @@
 // implicit in exactly these modes; Γ + Δt K_global stays symmetric positive definite, and applying it
 // costs one reduction per cell and constraint. The block-Jacobi preconditioner is left as it is (a rank-one
 // change costs CG at most one or two iterations).
+#include "core/cell_params.hpp"
 #include "core/geometry.hpp"
 #include "core/vec3.hpp"
 
@@ -36,12 +37,13 @@ struct GlobalStiffness {
 
 // Gradients ∇A (Σ_t ½ n_t × (x_k − x_j)) and ∇V (Σ_t A_t n_t / 3) at every node for the current geometry,
 // and the coefficients Δt k / X*. rest_area, rest_volume: the cells' rest values.
-template <class ExecutionSpace, class MemorySpace>
+// k_d, k_v: one value each or PerCell tables (core/cell_params.hpp).
+template <class ExecutionSpace, class MemorySpace, class KD, class KV>
 void update_global_stiffness(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                              const GeometryBuffers<MemorySpace>& geo,
                              const Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace>& rest_area,
                              const Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace>& rest_volume,
-                             double k_d, double k_v, double dt, const GlobalStiffness<MemorySpace>& g) {
+                             const KD& k_d, const KV& k_v, double dt, const GlobalStiffness<MemorySpace>& g) {
   const auto x = mesh.x;
   const auto tri = mesh.tri;
   const auto offsets = mesh.node_tri_offsets;
@@ -67,8 +69,8 @@ void update_global_stiffness(const ExecutionSpace& space, const MeshBuffers<Memo
   Kokkos::parallel_for(
       "dcm::global::coefficients", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_cells),
       KOKKOS_LAMBDA(const int c) {
-        coef_area(c) = with_area ? dt * k_d / rest_area(c) : 0.0;
-        coef_volume(c) = with_volume ? dt * k_v / rest_volume(c) : 0.0;
+        coef_area(c) = with_area ? dt * cell_value(k_d, c) / rest_area(c) : 0.0;
+        coef_volume(c) = with_volume ? dt * cell_value(k_v, c) / rest_volume(c) : 0.0;
       });
 }
 

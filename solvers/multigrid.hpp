@@ -219,7 +219,8 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
     const auto node_bonds = mesh.node_bonds;
     const auto dir = op.bond_dir;
     const auto drag = op.node_drag;
-    const double c = op.dashpot, c_t = op.dashpot_transverse;
+    const auto coef = op.cell_coef;  // per cell (FrictionCoef); update_friction() filled it
+    const auto node_cell = mesh.node_cell;
     // Substrate friction blocks β_ti β_tj Γ_t (solvers/friction_operator.hpp) lie on the same pattern: the
     // corners of a triangle are bond neighbours.
     const auto cols = a.cols;
@@ -236,6 +237,7 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
     Kokkos::parallel_for(
         "dcm::mg::assemble_fine", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows),
         KOKKOS_LAMBDA(const int i) {
+          const double c = coef(node_cell(i), kDashpot), c_t = coef(node_cell(i), kDashpotTransverse);
           for (int s = off(i); s < off(i + 1); ++s) {
             double blk[6] = {0, 0, 0, 0, 0, 0};
             const int b = slot_bond(s);

@@ -4,6 +4,16 @@
 // precondition(r, z). The iterate x is the warm start on entry and the solution on exit.
 // Stops when ||r||₂ ≤ max(abs_tol, rel_tol ||b||₂); the paper's setting is an absolute force residual
 // of 1e-14 N. Reaching max_iterations is reported (converged = false), never silently accepted.
+//
+// Per-cell CG (docs/SCANS.md, "The batched engine: design", point 3): the workspace's segments are the
+// cells (CgWorkspace(cell node offsets)); the operator and the preconditioner must then be block-diagonal
+// per cell (no coupling term between cells: true of every term dcm has). Each cell has its own α, β, norms,
+// tolerance and convergence: a converged cell freezes (its x and r no longer change) while the others
+// iterate, and the loop ends when every cell has stopped. Every per-cell number is a fixed-order sum over
+// that cell's nodes alone (core/segmented_sum.hpp), so a cell's iterates are bit for bit those of its solve
+// alone, whatever shares the launch. One segment over all nodes (CgWorkspace(n)) is plain CG.
+#include <vector>
+
 #include "core/segmented_sum.hpp"
 #include "core/vec3.hpp"
 
@@ -24,15 +34,35 @@ struct CgResult {
 template <class MemorySpace>
 struct CgWorkspace {
   using Vector = Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>;
+  using Scalars = Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace>;
   Vector r, z, p, q;
-  SumPlan<MemorySpace> sums;  // the dot products: thread-count independent (core/segmented_sum.hpp)
+  SumPlan<MemorySpace> sums;  // the dot products per segment: thread-count independent
+  Kokkos::View<int*, Kokkos::LayoutRight, MemorySpace> node_segment;
+  Scalars alpha, beta;  // per segment; 0 freezes a segment
+  typename Scalars::HostMirror alpha_host, beta_host;
+  std::vector<CgResult> segment_results;  // of the last solve, one per segment
+
   CgWorkspace() = default;
-  explicit CgWorkspace(int n)
-      : r(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::cg::r"), n),
-        z(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::cg::z"), n),
-        p(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::cg::p"), n),
-        q(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::cg::q"), n),
-        sums(std::vector<int>{0, n}) {}
+  explicit CgWorkspace(int n) : CgWorkspace(std::vector<int>{0, n}) {}
+  // segment_begin: the first node of every segment and the node count (cells: host_cell_node_begin).
+  explicit CgWorkspace(const std::vector<int>& segment_begin)
+      : r(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::cg::r"), segment_begin.back()),
+        z(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::cg::z"), segment_begin.back()),
+        p(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::cg::p"), segment_begin.back()),
+        q(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::cg::q"), segment_begin.back()),
+        sums(segment_begin),
+        node_segment("dcm::cg::node_segment", segment_begin.back()),
+        alpha("dcm::cg::alpha", segment_begin.size() - 1),
+        beta("dcm::cg::beta", segment_begin.size() - 1),
+        alpha_host(Kokkos::create_mirror_view(alpha)),
+        beta_host(Kokkos::create_mirror_view(beta)),
+        segment_results(segment_begin.size() - 1) {
+    auto h = Kokkos::create_mirror_view(node_segment);
+    for (std::size_t s = 0; s + 1 < segment_begin.size(); ++s)
+      for (int i = segment_begin[s]; i < segment_begin[s + 1]; ++i) h(i) = static_cast<int>(s);
+    Kokkos::deep_copy(node_segment, h);
+  }
+  int n_segments() const { return sums.n_segments; }
 };
 
 namespace cg_detail {
@@ -51,6 +81,42 @@ double dot(const ExecutionSpace& space, const SumPlan<MemorySpace>& plan, const 
   return sum[0];
 }
 
+// a · b per segment, into out[s] (host).
+template <class ExecutionSpace, class MemorySpace, class Vector>
+void segment_dots(const ExecutionSpace& space, const SumPlan<MemorySpace>& plan, const Vector& a,
+                  const Vector& b, std::vector<double>& out, const char* label = "dcm::cg::dot") {
+  segmented_sum<1>(
+      label, space, plan,
+      KOKKOS_LAMBDA(const int i, double(&acc)[1]) {
+        acc[0] += a(i, 0) * b(i, 0) + a(i, 1) * b(i, 1) + a(i, 2) * b(i, 2);
+      },
+      plan.result);
+  Kokkos::deep_copy(space, plan.result_host, plan.result);
+  space.fence();
+  for (int s = 0; s < plan.n_segments; ++s) out[s] = plan.result_host(s, 0);
+}
+
+// The aggregate of the segments' results: converged if all are; otherwise the first segment that is not
+// (a non-finite residual first), so messages name the real failure. Iterations: the most any segment took.
+inline CgResult combine(const std::vector<CgResult>& seg) {
+  CgResult all = seg.front();
+  int worst = -1;
+  for (std::size_t s = 0; s < seg.size(); ++s) {
+    all.iterations = seg[s].iterations > all.iterations ? seg[s].iterations : all.iterations;
+    if (!seg[s].converged && worst < 0) worst = static_cast<int>(s);
+    if (!(seg[s].residual_norm < INFINITY)) {
+      worst = static_cast<int>(s);
+      break;
+    }
+  }
+  if (worst >= 0) {
+    const int its = all.iterations;
+    all = seg[worst];
+    all.iterations = its;
+  }
+  return all;
+}
+
 }  // namespace cg_detail
 
 template <class ExecutionSpace, class Vector, class Apply, class Precondition, class Workspace>
@@ -58,15 +124,19 @@ CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& pr
                    const Vector& x, Workspace& w, const CgSettings& settings) {
   using Policy = Kokkos::RangePolicy<ExecutionSpace>;
   const int n = static_cast<int>(b.extent(0));
+  const int n_seg = w.n_segments();
   const auto r = w.r, z = w.z, p = w.p, q = w.q;
-  CgResult result;
+  const auto seg = w.node_segment;
+  const auto alpha = w.alpha, beta = w.beta;
   const auto& sums = w.sums;
-  result.rhs_norm = math::sqrt(cg_detail::dot(space, sums, b, b));
-  const double tol = math::max(settings.abs_tol, settings.rel_tol * result.rhs_norm);
+  auto& res = w.segment_results;
+  std::vector<double> bb(n_seg), rr(n_seg), rz(n_seg), pq(n_seg), rz_new(n_seg), tol(n_seg);
+  std::vector<char> active(n_seg, 0);
+  int n_active = 0;
 
+  cg_detail::segment_dots(space, sums, b, b, bb);
   apply(x, q);  // r = b - Γ x
-  double rr[1];
-  segmented_total<1>(
+  segmented_sum<1>(
       "dcm::cg::initial_residual", space, sums,
       KOKKOS_LAMBDA(const int i, double(&s)[1]) {
         for (int d = 0; d < 3; ++d) {
@@ -74,44 +144,66 @@ CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& pr
           s[0] += r(i, d) * r(i, d);
         }
       },
-      rr);
-  result.residual_norm = math::sqrt(rr[0]);
-  if (result.residual_norm <= tol) {
-    result.converged = true;
-    return result;
+      sums.result);
+  Kokkos::deep_copy(space, sums.result_host, sums.result);
+  space.fence();
+  for (int s = 0; s < n_seg; ++s) {
+    res[s] = CgResult{};
+    res[s].rhs_norm = math::sqrt(bb[s]);
+    tol[s] = math::max(settings.abs_tol, settings.rel_tol * res[s].rhs_norm);
+    res[s].residual_norm = math::sqrt(sums.result_host(s, 0));
+    res[s].converged = res[s].residual_norm <= tol[s];
+    active[s] = res[s].converged ? 0 : 1;
+    n_active += active[s];
   }
+  if (n_active == 0) return cg_detail::combine(res);
   precondition(r, z);
   Kokkos::deep_copy(space, p, z);
-  double rz = cg_detail::dot(space, sums, r, z);
+  cg_detail::segment_dots(space, sums, r, z, rz);
   for (int it = 1; it <= settings.max_iterations; ++it) {
     apply(p, q);
-    const double alpha = rz / cg_detail::dot(space, sums, p, q);
-    segmented_total<1>(
+    cg_detail::segment_dots(space, sums, p, q, pq);
+    for (int s = 0; s < n_seg; ++s) w.alpha_host(s) = active[s] ? rz[s] / pq[s] : 0.0;
+    Kokkos::deep_copy(space, alpha, w.alpha_host);
+    segmented_sum<1>(
         "dcm::cg::update", space, sums,
         KOKKOS_LAMBDA(const int i, double(&s)[1]) {
-          for (int d = 0; d < 3; ++d) {
-            x(i, d) += alpha * p(i, d);
-            r(i, d) -= alpha * q(i, d);
-            s[0] += r(i, d) * r(i, d);
-          }
+          const double a = alpha(seg(i));
+          if (a != 0)  // a frozen segment keeps its x and r
+            for (int d = 0; d < 3; ++d) {
+              x(i, d) += a * p(i, d);
+              r(i, d) -= a * q(i, d);
+            }
+          for (int d = 0; d < 3; ++d) s[0] += r(i, d) * r(i, d);
         },
-        rr);
-    result.iterations = it;
-    result.residual_norm = math::sqrt(rr[0]);
-    if (!(result.residual_norm > tol)) {  // also stops on NaN; the caller checks finiteness
-      result.converged = result.residual_norm <= tol;
-      return result;
+        sums.result);
+    Kokkos::deep_copy(space, sums.result_host, sums.result);
+    space.fence();
+    for (int s = 0; s < n_seg; ++s) {
+      if (!active[s]) continue;
+      res[s].iterations = it;
+      res[s].residual_norm = math::sqrt(sums.result_host(s, 0));
+      if (!(res[s].residual_norm > tol[s])) {  // also stops on NaN; the caller checks finiteness
+        res[s].converged = res[s].residual_norm <= tol[s];
+        active[s] = 0;
+        --n_active;
+      }
     }
+    if (n_active == 0) break;
     precondition(r, z);
-    const double rz_new = cg_detail::dot(space, sums, r, z);
-    const double beta = rz_new / rz;
-    rz = rz_new;
+    cg_detail::segment_dots(space, sums, r, z, rz_new);
+    for (int s = 0; s < n_seg; ++s) {
+      w.beta_host(s) = active[s] ? rz_new[s] / rz[s] : 0.0;
+      if (active[s]) rz[s] = rz_new[s];
+    }
+    Kokkos::deep_copy(space, beta, w.beta_host);
     Kokkos::parallel_for(
         "dcm::cg::direction", Policy(space, 0, n), KOKKOS_LAMBDA(const int i) {
-          for (int d = 0; d < 3; ++d) p(i, d) = z(i, d) + beta * p(i, d);
+          const double bt = beta(seg(i));
+          for (int d = 0; d < 3; ++d) p(i, d) = z(i, d) + bt * p(i, d);
         });
   }
-  return result;
+  return cg_detail::combine(res);
 }
 
 }  // namespace dcm

@@ -31,10 +31,12 @@ struct TensionStiffness {
 };
 
 // Caches ê and n_t for the current geometry (update_geometry() first) and step dt.
-template <class ExecutionSpace, class MemorySpace>
+// k_a, k_d: one value each or PerCell tables (core/cell_params.hpp).
+template <class ExecutionSpace, class MemorySpace, class KA, class KD>
 void update_tension_stiffness(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                               const GeometryBuffers<MemorySpace>& geo, const AreaRest<MemorySpace>& rest,
-                              double k_a, double k_d, double dt, const TensionStiffness<MemorySpace>& ts) {
+                              const KA& k_a, const KD& k_d, double dt,
+                              const TensionStiffness<MemorySpace>& ts) {
   const auto x = mesh.x;
   const auto tri = mesh.tri;
   const auto tri_cell = mesh.tri_cell;
@@ -47,8 +49,8 @@ void update_tension_stiffness(const ExecutionSpace& space, const MeshBuffers<Mem
       "dcm::tension_stiffness::update", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_tris),
       KOKKOS_LAMBDA(const int t) {
         const int c = tri_cell(t);
-        const double sigma =
-            k_a * (area(t) - rest_tri(t)) / rest_tri(t) + k_d * (cell_area(c) - rest_cell(c)) / rest_cell(c);
+        const double sigma = cell_value(k_a, c) * (area(t) - rest_tri(t)) / rest_tri(t) +
+                             cell_value(k_d, c) * (cell_area(c) - rest_cell(c)) / rest_cell(c);
         const double w = (sigma > 0 && area(t) > 0) ? math::sqrt(dt * sigma / (4 * area(t))) : 0.0;
         for (int k = 0; k < 3; ++k) {
           const Real3 e = load3(x, tri(t, (k + 2) % 3)) - load3(x, tri(t, (k + 1) % 3));  // opposite corner k

@@ -1,0 +1,55 @@
+#pragma once
+// Constants that may differ from cell to cell (the batched engine: docs/SCANS.md, "The batched engine:
+// design", point 1). Kernels read a constant for the cell of the element they work on with
+// cell_value(k, cell): k is either one value for every cell (a double or a parameter struct, as a single
+// run passes it) or a PerCell table with a row per cell. Both give the same arithmetic for a cell, so a
+// cell of a batch computes exactly what it computes alone.
+#include <Kokkos_Core.hpp>
+#include <string>
+#include <vector>
+
+namespace dcm {
+
+template <class T, class MemorySpace>
+struct PerCell {
+  Kokkos::View<T*, Kokkos::LayoutRight, MemorySpace> values;
+  std::vector<T> host;  // the same rows, for host-side decisions (is a term on anywhere?)
+  PerCell() = default;
+  explicit PerCell(const std::vector<T>& rows, const char* label = "dcm::per_cell")
+      : values(Kokkos::view_alloc(Kokkos::WithoutInitializing, std::string(label)), rows.size()), host(rows) {
+    auto h = Kokkos::create_mirror_view(values);
+    for (std::size_t c = 0; c < rows.size(); ++c) h(c) = rows[c];
+    Kokkos::deep_copy(values, h);
+  }
+};
+
+// The same value for every cell.
+template <class T>
+KOKKOS_INLINE_FUNCTION const T& cell_value(const T& uniform, int) {
+  return uniform;
+}
+// Cell c's row.
+template <class T, class MemorySpace>
+KOKKOS_INLINE_FUNCTION T cell_value(const PerCell<T, MemorySpace>& table, int c) {
+  return table.values(c);
+}
+
+// Whether a constant is non-zero for some cell (a term with a zero constant everywhere is skipped).
+inline bool any_nonzero(double k) { return k != 0; }
+template <class MemorySpace>
+bool any_nonzero(const PerCell<double, MemorySpace>& table) {
+  for (const double k : table.host)
+    if (k != 0) return true;
+  return false;
+}
+
+// One member of each cell's parameter struct as a table: member_table(cells, &P::k_b).
+template <class MemorySpace, class P, class T>
+PerCell<T, MemorySpace> member_table(const std::vector<P>& cells, T P::*member, const char* label) {
+  std::vector<T> v;
+  v.reserve(cells.size());
+  for (const P& p : cells) v.push_back(p.*member);
+  return PerCell<T, MemorySpace>(v, label);
+}
+
+}  // namespace dcm
