@@ -21,6 +21,17 @@ struct PerCell {
     for (std::size_t c = 0; c < rows.size(); ++c) h(c) = rows[c];
     Kokkos::deep_copy(values, h);
   }
+  // New rows of the same count (no allocation: for values that change every step).
+  void assign(const std::vector<T>& rows) {
+    if (rows.size() != values.extent(0)) {
+      *this = PerCell(rows, values.label().c_str());
+      return;
+    }
+    host = rows;
+    auto h = Kokkos::create_mirror_view(values);
+    for (std::size_t c = 0; c < rows.size(); ++c) h(c) = rows[c];
+    Kokkos::deep_copy(values, h);
+  }
 };
 
 // The same value for every cell.

@@ -115,6 +115,38 @@ void segmented_total(const std::string& label, const ExecutionSpace& space, cons
     for (int c = 0; c < N; ++c) total[c] += plan.result_host(s, c);
 }
 
+// out[s] = the largest term(k) over the elements k of segment s (0 for an empty segment; a NaN term is
+// skipped). A maximum does not depend on the order, so this only saves one launch per segment.
+template <class ExecutionSpace, class MemorySpace, class Term>
+void segmented_max(const std::string& label, const ExecutionSpace& space, const SumPlan<MemorySpace>& plan,
+                   const Term& term, std::vector<double>& out) {
+  const auto range = plan.chunk_range;
+  const auto partial = plan.partial;
+  const auto chunks = plan.segment_chunks;
+  const auto result = plan.result;
+  Kokkos::parallel_for(
+      label, Kokkos::RangePolicy<ExecutionSpace>(space, 0, plan.n_chunks), KOKKOS_LAMBDA(const int q) {
+        double m = 0;
+        for (int k = range(q, 0); k < range(q, 1); ++k) {
+          const double v = term(k);
+          if (v > m) m = v;
+        }
+        partial(q, 0) = m;
+      });
+  Kokkos::parallel_for(
+      label + "::segments", Kokkos::RangePolicy<ExecutionSpace>(space, 0, plan.n_segments),
+      KOKKOS_LAMBDA(const int s) {
+        double m = 0;
+        for (int q = chunks(s); q < chunks(s + 1); ++q)
+          if (partial(q, 0) > m) m = partial(q, 0);
+        result(s, 0) = m;
+      });
+  Kokkos::deep_copy(space, plan.result_host, plan.result);
+  space.fence();
+  out.resize(plan.n_segments);
+  for (int s = 0; s < plan.n_segments; ++s) out[s] = plan.result_host(s, 0);
+}
+
 // One component: Σ term over every element of the plan, in the fixed order.
 template <class ExecutionSpace, class MemorySpace, class Term>
 double fixed_order_sum(const std::string& label, const ExecutionSpace& space,

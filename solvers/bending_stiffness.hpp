@@ -29,15 +29,17 @@ struct BendingStiffness {
 // The stiffness of a step dt; ∇θ and cos(θ − θ*) come from the last add_bending_forces()
 // (kernels/bending.hpp).
 // k_b: the bending constant of every cell (J), one entry per cell (or one for all).
+// dt: each cell's step (or one for all).
 template <class MemorySpace>
-void update_bending_stiffness(const std::vector<double>& k_b, double dt, BendingStiffness<MemorySpace>& bs) {
+void update_bending_stiffness(const std::vector<double>& k_b, const std::vector<double>& dt,
+                              BendingStiffness<MemorySpace>& bs) {
   for (std::size_t c = 0; c < bs.dt_k_b_host.extent(0); ++c)
-    bs.dt_k_b_host(c) = dt * k_b[k_b.size() == 1 ? 0 : c];
+    bs.dt_k_b_host(c) = dt[dt.size() == 1 ? 0 : c] * k_b[k_b.size() == 1 ? 0 : c];
   Kokkos::deep_copy(bs.dt_k_b, bs.dt_k_b_host);
 }
 template <class MemorySpace>
 void update_bending_stiffness(double k_b, double dt, BendingStiffness<MemorySpace>& bs) {
-  update_bending_stiffness(std::vector<double>{k_b}, dt, bs);
+  update_bending_stiffness(std::vector<double>{k_b}, std::vector<double>{dt}, bs);
 }
 
 // out += Δt K_bend v.

@@ -238,6 +238,26 @@ class CortexModel {
     return m;
   }
 
+  // The same per cell (a batch's cells step on their own; a non-finite length counts as infinitely long).
+  std::vector<double> cell_max_bond_extension() const {
+    std::vector<double> m(mesh_.n_cells, 0.0);
+    if (!bonds_) return m;
+    const auto x = mesh_.x;
+    const auto bond = mesh_.bond;
+    const auto rest = bonds_->rest_length;
+    const auto bond_cell = mesh_.bond_cell;
+    const auto table = bond_params_;
+    segmented_max(
+        "dcm::model::cell_max_bond_extension", space_, mesh_.bond_sums,
+        KOKKOS_LAMBDA(const int b) {
+          const double x_max = cell_value(table, bond_cell(b)).x_max;
+          const double e = norm(load3(x, bond(b, 1)) - load3(x, bond(b, 0))) / (x_max * rest(b));
+          return e <= 1e300 ? e : 1e308;
+        },
+        m);
+    return m;
+  }
+
   // Power of the contact forces at the current velocity (W); 0 without a plane.
   double contact_power() const {
     return contact_ ? dcm::contact_power(space_, mesh_, params_.plane, *contact_, velocity_) : 0.0;
@@ -296,6 +316,19 @@ class CortexModel {
   // With throw_if_unconverged = false a solve that reaches the iteration cap returns converged = false
   // (the time stepper then retries with a shorter step; unconverged_message() says what happened).
   CgResult solve_velocity(const CgSettings& settings, double dt = 0, bool throw_if_unconverged = true) {
+    return solve_velocity(settings, std::vector<double>(mesh_.n_cells, dt), nullptr, throw_if_unconverged);
+  }
+  // A batch: cell c's implicit terms for its own step dt_cells[c] (all > 0, or all 0); cells flagged in
+  // `frozen` keep their velocity (they are not stepping now). cell_solves() has each cell's result.
+  CgResult solve_velocity(const CgSettings& settings, const std::vector<double>& dt_cells,
+                          const std::vector<char>* frozen, bool throw_if_unconverged = true) {
+    if (static_cast<int>(dt_cells.size()) != mesh_.n_cells)
+      throw std::invalid_argument("solve_velocity: one step per cell expected");
+    const bool with_dt = dt_cells[0] > 0;
+    for (const double h : dt_cells)
+      if ((h > 0) != with_dt) throw std::invalid_argument("solve_velocity: steps must be all positive or all 0");
+    dt_.assign(dt_cells);
+    const double dt = with_dt ? 1.0 : 0.0;                   // only its sign is used below
     const bool implicit_bonds = dt > 0 && params_.implicit_bonds && bonds_.has_value();
     if (implicit_bonds) {
       if (friction_.bond_stiffness_dt.extent(0) == 0)
@@ -307,13 +340,14 @@ class CortexModel {
       const auto k_dt = friction_.bond_stiffness_dt;
       const auto bond_cell = mesh_.bond_cell;
       const auto table = bond_params_;
+      const auto step = dt_;
       Kokkos::parallel_for(
           "dcm::model::implicit_bonds", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_bonds),
           KOKKOS_LAMBDA(const int b) {
             const FenePowParams pr = cell_value(table, bond_cell(b));
             const double k_s = pr.k_s, x_max = pr.x_max;
             const double d = norm(load3(x, bond(b, 1)) - load3(x, bond(b, 0)));
-            k_dt(b) = dt * fene_pow_implicit_stiffness(d, rest(b), k_s, x_max);
+            k_dt(b) = cell_value(step, bond_cell(b)) * fene_pow_implicit_stiffness(d, rest(b), k_s, x_max);
           });
     } else {
       friction_.bond_stiffness_dt = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
@@ -321,7 +355,7 @@ class CortexModel {
     update_friction(space_, mesh_, friction_);
     const bool implicit_tension = dt > 0 && tension_stiffness_.has_value();
     if (implicit_tension)
-      update_tension_stiffness(space_, mesh_, geo_, *area_, k_area_local_, k_area_global_, dt,
+      update_tension_stiffness(space_, mesh_, geo_, *area_, k_area_local_, k_area_global_, dt_,
                                *tension_stiffness_);
     // The multigrid's fine level holds Γ, the implicit bonds and the implicit tension (same sparsity).
     if (multigrid_) {
@@ -336,11 +370,11 @@ class CortexModel {
     const bool implicit = dt > 0 && global_.has_value();
     const bool implicit_bending = dt > 0 && bending_stiffness_.has_value();
     if (implicit_bending)
-      update_bending_stiffness(k_b_.host, dt, *bending_stiffness_);  // ∇θ from compute_forces()
+      update_bending_stiffness(k_b_.host, dt_cells, *bending_stiffness_);  // ∇θ from compute_forces()
     if (implicit)
       update_global_stiffness(space_, mesh_, geo_, area_ ? area_->cell_area : volume_->cell_volume,
                               volume_ ? volume_->cell_volume : area_->cell_area, k_area_global_, k_volume_,
-                              dt, *global_);
+                              dt_, *global_);
     if (params_.dashpot == 0 && params_.dashpot_transverse == 0 && !friction_.substrate && !implicit &&
         !implicit_bending && !implicit_bonds && !implicit_tension) {
       apply_block_jacobi(space_, friction_, force_, velocity_);
@@ -363,7 +397,7 @@ class CortexModel {
           else
             apply_block_jacobi(space_, friction_, in, out);
         },
-        force_, velocity_, cg_, settings);
+        force_, velocity_, cg_, settings, frozen);
     if (!r.converged && !(r.residual_norm < INFINITY)) {
       const int bad_v = first_non_finite_node(space_, velocity_);
       throw NumericalError(std::string("conjugate gradients diverged: the residual is not finite") +
@@ -540,6 +574,7 @@ class CortexModel {
   PerCell<FenePowParams, Mem> bond_params_;
   PerCell<double, Mem> k_b_, k_area_local_, k_area_global_, k_volume_;
   PerCell<PlaneContactParams, Mem> contact_params_;
+  PerCell<double, Mem> dt_{std::vector<double>{}, "dcm::model::dt"};  // each cell's step in the last solve
   MeshBuffers<Mem> mesh_;
   GeometryBuffers<Mem> geo_;
   Vector force_, velocity_, external_;

@@ -38,12 +38,12 @@ struct GlobalStiffness {
 // Gradients ∇A (Σ_t ½ n_t × (x_k − x_j)) and ∇V (Σ_t A_t n_t / 3) at every node for the current geometry,
 // and the coefficients Δt k / X*. rest_area, rest_volume: the cells' rest values.
 // k_d, k_v: one value each or PerCell tables (core/cell_params.hpp).
-template <class ExecutionSpace, class MemorySpace, class KD, class KV>
+template <class ExecutionSpace, class MemorySpace, class KD, class KV, class DT>
 void update_global_stiffness(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                              const GeometryBuffers<MemorySpace>& geo,
                              const Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace>& rest_area,
                              const Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace>& rest_volume,
-                             const KD& k_d, const KV& k_v, double dt, const GlobalStiffness<MemorySpace>& g) {
+                             const KD& k_d, const KV& k_v, const DT& dt, const GlobalStiffness<MemorySpace>& g) {
   const auto x = mesh.x;
   const auto tri = mesh.tri;
   const auto offsets = mesh.node_tri_offsets;
@@ -69,8 +69,8 @@ void update_global_stiffness(const ExecutionSpace& space, const MeshBuffers<Memo
   Kokkos::parallel_for(
       "dcm::global::coefficients", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_cells),
       KOKKOS_LAMBDA(const int c) {
-        coef_area(c) = with_area ? dt * cell_value(k_d, c) / rest_area(c) : 0.0;
-        coef_volume(c) = with_volume ? dt * cell_value(k_v, c) / rest_volume(c) : 0.0;
+        coef_area(c) = with_area ? cell_value(dt, c) * cell_value(k_d, c) / rest_area(c) : 0.0;
+        coef_volume(c) = with_volume ? cell_value(dt, c) * cell_value(k_v, c) / rest_volume(c) : 0.0;
       });
 }
 

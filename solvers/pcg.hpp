@@ -119,9 +119,12 @@ inline CgResult combine(const std::vector<CgResult>& seg) {
 
 }  // namespace cg_detail
 
+// frozen (optional, one flag per segment): segments whose x is kept as it is (a batch's cells that are not
+// stepping now); their results read converged with 0 iterations.
 template <class ExecutionSpace, class Vector, class Apply, class Precondition, class Workspace>
 CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& precondition, const Vector& b,
-                   const Vector& x, Workspace& w, const CgSettings& settings) {
+                   const Vector& x, Workspace& w, const CgSettings& settings,
+                   const std::vector<char>* frozen = nullptr) {
   using Policy = Kokkos::RangePolicy<ExecutionSpace>;
   const int n = static_cast<int>(b.extent(0));
   const int n_seg = w.n_segments();
@@ -153,6 +156,7 @@ CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& pr
     tol[s] = math::max(settings.abs_tol, settings.rel_tol * res[s].rhs_norm);
     res[s].residual_norm = math::sqrt(sums.result_host(s, 0));
     res[s].converged = res[s].residual_norm <= tol[s];
+    if (frozen && (*frozen)[s]) res[s].converged = true;
     active[s] = res[s].converged ? 0 : 1;
     n_active += active[s];
   }

@@ -32,10 +32,10 @@ struct TensionStiffness {
 
 // Caches ê and n_t for the current geometry (update_geometry() first) and step dt.
 // k_a, k_d: one value each or PerCell tables (core/cell_params.hpp).
-template <class ExecutionSpace, class MemorySpace, class KA, class KD>
+template <class ExecutionSpace, class MemorySpace, class KA, class KD, class DT>
 void update_tension_stiffness(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                               const GeometryBuffers<MemorySpace>& geo, const AreaRest<MemorySpace>& rest,
-                              const KA& k_a, const KD& k_d, double dt,
+                              const KA& k_a, const KD& k_d, const DT& dt_cells,
                               const TensionStiffness<MemorySpace>& ts) {
   const auto x = mesh.x;
   const auto tri = mesh.tri;
@@ -51,7 +51,7 @@ void update_tension_stiffness(const ExecutionSpace& space, const MeshBuffers<Mem
         const int c = tri_cell(t);
         const double sigma = cell_value(k_a, c) * (area(t) - rest_tri(t)) / rest_tri(t) +
                              cell_value(k_d, c) * (cell_area(c) - rest_cell(c)) / rest_cell(c);
-        const double w = (sigma > 0 && area(t) > 0) ? math::sqrt(dt * sigma / (4 * area(t))) : 0.0;
+        const double w = (sigma > 0 && area(t) > 0) ? math::sqrt(cell_value(dt_cells, c) * sigma / (4 * area(t))) : 0.0;
         for (int k = 0; k < 3; ++k) {
           const Real3 e = load3(x, tri(t, (k + 2) % 3)) - load3(x, tri(t, (k + 1) % 3));  // opposite corner k
           edge(t, k, 0) = w * e.x;

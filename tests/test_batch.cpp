@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/host_copy.hpp"
+#include "solvers/batch_stepper.hpp"
 #include "solvers/time_stepper.hpp"
 
 namespace dcm {
@@ -128,6 +129,57 @@ TEST(Batch, CellsWithDifferentConstantsStepExactlyAsAlone) {
   EXPECT_GT(diff, 1e-9) << "largest coordinate difference between the cells (m)";
   EXPECT_GT(alone0.contact_area(), 0.0);
   std::printf("  after 40 steps the cells differ by up to %.3g m\n", diff);
+}
+
+// Adaptive steps: each cell of the batch takes its own steps (lengths, rejections, halvings) and stops at
+// its own end time, exactly as alone.
+TEST(Batch, EachCellTakesItsOwnAdaptiveStepsAsAlone) {
+  const double r = 3.25e-6, a = 0.3e-6;
+  const HostMesh sphere = make_icosphere(3, r);
+  const int n = static_cast<int>(sphere.nodes.size());
+  const MechanicsParams p0 = spreading(r, a), p1 = other_constants(r, a);
+  TimeStepSettings s;
+  s.dt = 6e-6;
+  s.adaptive = true;
+  s.error_tol_m = 1e-9;
+  const double t_end[2] = {4e-4, 2.5e-4};
+  const CgSettings cg;
+  // Alone: the single-run stepper.
+  std::vector<std::vector<double>> alone_h(2), alone_x(2);
+  int alone_rejections[2] = {0, 0}, alone_halvings[2] = {0, 0};
+  for (int c = 0; c < 2; ++c) {
+    CortexModel<Exec> m(Exec(), {HostCell(sphere)}, c == 0 ? p0 : p1);
+    TimeStepper<Exec> stepper(n, s);
+    while (stepper.time() < t_end[c]) {
+      const StepReport rep = stepper.step(m, cg, t_end[c] - stepper.time(), [](double) {});
+      alone_h[c].push_back(rep.h);
+      alone_rejections[c] += rep.rejections;
+      alone_halvings[c] += rep.halvings;
+    }
+    alone_x[c] = to_host_vector(m.positions());
+  }
+  // Batched.
+  CortexModel<Exec> batch(Exec(), {HostCell(sphere), HostCell(sphere)}, std::vector<MechanicsParams>{p0, p1});
+  BatchStepper<Exec> stepper(batch, s);
+  std::vector<std::vector<double>> batch_h(2);
+  for (;;) {
+    std::vector<double> cap(2);
+    for (int c = 0; c < 2; ++c) cap[c] = stepper.time(c) < t_end[c] ? t_end[c] - stepper.time(c) : 0.0;
+    if (cap[0] == 0 && cap[1] == 0) break;
+    const std::vector<StepReport> rep = stepper.step(batch, cg, cap, [](const std::vector<double>&) {});
+    for (int c = 0; c < 2; ++c)
+      if (cap[c] > 0) batch_h[c].push_back(rep[c].h);
+  }
+  for (int c = 0; c < 2; ++c) {
+    EXPECT_EQ(batch_h[c], alone_h[c]) << "cell " << c << ": the step lengths";
+    EXPECT_EQ(stepper.time(c), t_end[c]);
+    EXPECT_EQ(part(batch.positions(), c * n, n), alone_x[c]) << "cell " << c;
+  }
+  EXPECT_NE(alone_h[0].size(), alone_h[1].size()) << "the cells take different numbers of steps";
+  EXPECT_GT(alone_rejections[0] + alone_rejections[1] + alone_halvings[0] + alone_halvings[1], 0)
+      << "a rejection or halving is exercised";
+  std::printf("  steps %zu / %zu, rejections %d / %d, halvings %d / %d\n", alone_h[0].size(), alone_h[1].size(),
+              alone_rejections[0], alone_rejections[1], alone_halvings[0], alone_halvings[1]);
 }
 
 TEST(Batch, CellsThatNeedDifferentKernelsCannotShareABatch) {
