@@ -55,7 +55,9 @@ MeshBuffers<MemorySpace> upload_cells(const std::vector<HostCell>& cells) {
   b.tri_sums = SumPlan<MemorySpace>(tb);
   b.bond_sums = SumPlan<MemorySpace>(bb);
   b.hinge_sums = SumPlan<MemorySpace>(hb);
-  b.cell_sums = SumPlan<MemorySpace>(std::vector<int>{0, b.n_cells});
+  std::vector<int> cb(b.n_cells + 1);  // one segment per cell: per-cell values of per-cell terms
+  for (int c = 0; c <= b.n_cells; ++c) cb[c] = c;
+  b.cell_sums = SumPlan<MemorySpace>(cb);
 
   // Per-element arrays: walk cells, offset node indices by the cell's first node.
   auto per_cell = [&](auto&& body) {

@@ -104,15 +104,20 @@ struct PairOut {
 };
 
 // The sums over all segments (the segments added in order), on the host.
+// per_segment (optional): also each segment's sum of the first component (a cell's own value).
 template <int N, class ExecutionSpace, class MemorySpace, class Term>
 void segmented_total(const std::string& label, const ExecutionSpace& space, const SumPlan<MemorySpace>& plan,
-                     const Term& term, double (&total)[N]) {
+                     const Term& term, double (&total)[N], std::vector<double>* per_segment = nullptr) {
   segmented_sum<N>(label, space, plan, term, plan.result);
   Kokkos::deep_copy(space, plan.result_host, plan.result);
   space.fence();
   for (int c = 0; c < N; ++c) total[c] = 0;
   for (int s = 0; s < plan.n_segments; ++s)
     for (int c = 0; c < N; ++c) total[c] += plan.result_host(s, c);
+  if (per_segment) {
+    per_segment->resize(plan.n_segments);
+    for (int s = 0; s < plan.n_segments; ++s) (*per_segment)[s] = plan.result_host(s, 0);
+  }
 }
 
 // out[s] = the largest term(k) over the elements k of segment s (0 for an empty segment; a NaN term is
@@ -148,12 +153,15 @@ void segmented_max(const std::string& label, const ExecutionSpace& space, const 
 }
 
 // One component: Σ term over every element of the plan, in the fixed order.
+// per_segment (optional): also each segment's sum.
 template <class ExecutionSpace, class MemorySpace, class Term>
 double fixed_order_sum(const std::string& label, const ExecutionSpace& space,
-                       const SumPlan<MemorySpace>& plan, const Term& term) {
+                       const SumPlan<MemorySpace>& plan, const Term& term,
+                       std::vector<double>* per_segment = nullptr) {
   double total[1];
   segmented_total<1>(
-      label, space, plan, KOKKOS_LAMBDA(const int k, double(&acc)[1]) { acc[0] += term(k); }, total);
+      label, space, plan, KOKKOS_LAMBDA(const int k, double(&acc)[1]) { acc[0] += term(k); }, total,
+      per_segment);
   return total[0];
 }
 

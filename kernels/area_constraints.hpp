@@ -110,25 +110,34 @@ void add_area_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpace>
 template <class ExecutionSpace, class MemorySpace, class KA, class KD>
 double area_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                    const GeometryBuffers<MemorySpace>& geo, const AreaRest<MemorySpace>& rest, const KA& k_a,
-                   const KD& k_d) {
+                   const KD& k_d, std::vector<double>* per_cell = nullptr) {
   const auto area = geo.tri_area;
   const auto tri_cell = mesh.tri_cell;
   const auto cell_area = geo.cell_area;
   const auto rest_area = rest.tri_area;
   const auto rest_cell_area = rest.cell_area;
   double local = 0, global = 0;
+  std::vector<double> local_cell(mesh.n_cells, 0.0), global_cell(mesh.n_cells, 0.0);
   if (any_nonzero(k_a))
     local = fixed_order_sum(
-        "dcm::area::energy_local", space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) {
+        "dcm::area::energy_local", space, mesh.tri_sums,
+        KOKKOS_LAMBDA(const int t) {
           const double d = area(t) - rest_area(t);
           return 0.5 * cell_value(k_a, tri_cell(t)) * d * d / rest_area(t);
-        });
+        },
+        &local_cell);
   if (any_nonzero(k_d))
     global = fixed_order_sum(
-        "dcm::area::energy_global", space, mesh.cell_sums, KOKKOS_LAMBDA(const int c) {
+        "dcm::area::energy_global", space, mesh.cell_sums,
+        KOKKOS_LAMBDA(const int c) {
           const double d = cell_area(c) - rest_cell_area(c);
           return 0.5 * cell_value(k_d, c) * d * d / rest_cell_area(c);
-        });
+        },
+        &global_cell);
+  if (per_cell) {
+    per_cell->resize(mesh.n_cells);
+    for (int c = 0; c < mesh.n_cells; ++c) (*per_cell)[c] = local_cell[c] + global_cell[c];
+  }
   return local + global;
 }
 

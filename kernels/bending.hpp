@@ -219,20 +219,23 @@ void add_bending_forces_per_node(const ExecutionSpace& space, const MeshBuffers<
 // Total bending energy of all cells (J).
 template <class ExecutionSpace, class MemorySpace, class KB>
 double bending_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                      const HingeRest<MemorySpace>& rest, const KB& k_b) {
+                      const HingeRest<MemorySpace>& rest, const KB& k_b,
+                      std::vector<double>* per_cell = nullptr) {
   const auto x = mesh.x;
   const auto hinge_cell = mesh.hinge_cell;
   const auto hinge = mesh.hinge;
   const auto rest_trig = rest.rest_trig;
   return fixed_order_sum(
-      "dcm::bending::energy", space, mesh.hinge_sums, KOKKOS_LAMBDA(const int h) {
+      "dcm::bending::energy", space, mesh.hinge_sums,
+      KOKKOS_LAMBDA(const int h) {
         double c, s;
         Real3 grad[4];
         hinge_trig_gradient(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
                             load3(x, hinge(h, 3)), c, s, grad);
         return cell_value(k_b, hinge_cell(h)) *
                (1 - (c * rest_trig(h, 0) + s * rest_trig(h, 1)));  // 1 - cos(theta - theta*)
-      });
+      },
+      per_cell);
 }
 
 }  // namespace dcm

@@ -69,16 +69,19 @@ void compute_node_fields(const ExecutionSpace& space, const MeshBuffers<MemorySp
 template <class ExecutionSpace, class MemorySpace>
 double contact_power(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh, const Plane& plane,
                      const ContactBuffers<MemorySpace>& contact,
-                     const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& velocity) {
+                     const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& velocity,
+                     std::vector<double>* per_cell = nullptr) {
   const auto tri = mesh.tri;
   const auto load = contact.tri_node_load;
   const Real3 n = (1.0 / norm(plane.normal)) * plane.normal;
   return fixed_order_sum(
-      "dcm::fields::contact_power", space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) {
+      "dcm::fields::contact_power", space, mesh.tri_sums,
+      KOKKOS_LAMBDA(const int t) {
         double s = 0;
         for (int c = 0; c < 3; ++c) s += load(t, c) * dot(n, load3(velocity, tri(t, c)));
         return s;
-      });
+      },
+      per_cell);
 }
 
 }  // namespace dcm

@@ -20,10 +20,11 @@ void add_external_forces(const ExecutionSpace& space,
 template <class ExecutionSpace, class MemorySpace>
 double external_energy(const ExecutionSpace& space, const SumPlan<MemorySpace>& node_sums,
                        const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& external,
-                       const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& x) {
+                       const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& x,
+                       std::vector<double>* per_cell = nullptr) {
   return fixed_order_sum(
       "dcm::external::energy", space, node_sums,
-      KOKKOS_LAMBDA(const int i) { return -dot(load3(external, i), load3(x, i)); });
+      KOKKOS_LAMBDA(const int i) { return -dot(load3(external, i), load3(x, i)); }, per_cell);
 }
 
 }  // namespace dcm

@@ -139,19 +139,22 @@ void add_fene_pow_forces(const ExecutionSpace& space, const MeshBuffers<MemorySp
 // Total FENE + POW energy of all cells (J); +infinity if a bond cannot be evaluated.
 template <class ExecutionSpace, class MemorySpace, class Params>
 double fene_pow_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                       const BondRest<MemorySpace>& rest, const Params& params) {
+                       const BondRest<MemorySpace>& rest, const Params& params,
+                       std::vector<double>* per_cell = nullptr) {
   const auto x = mesh.x;
   const auto bond = mesh.bond;
   const auto bond_cell = mesh.bond_cell;
   const auto rest_length = rest.rest_length;
   const double infinity = std::numeric_limits<double>::infinity();
   return fixed_order_sum(
-      "dcm::bonds::fene_pow_energy", space, mesh.bond_sums, KOKKOS_LAMBDA(const int b) {
+      "dcm::bonds::fene_pow_energy", space, mesh.bond_sums,
+      KOKKOS_LAMBDA(const int b) {
         const FenePowParams pr = cell_value(params, bond_cell(b));
         const double k_s = pr.k_s, x_max = pr.x_max;
         const double d = norm(load3(x, bond(b, 0)) - load3(x, bond(b, 1))), d_rest = rest_length(b);
         return fene_pow_bond_ok(d, d_rest, x_max) ? fene_pow_bond_energy(d, d_rest, k_s, x_max) : infinity;
-      });
+      },
+      per_cell);
 }
 
 }  // namespace dcm

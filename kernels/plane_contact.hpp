@@ -239,23 +239,25 @@ void add_plane_contact_forces(const ExecutionSpace& space, const MeshBuffers<Mem
       });
 }
 
-// Σ_t A^C_t per cell is what r_cc = sqrt(A^C / π) needs; here the whole mesh (one cell). Fixed summation
+// Σ_t A^C_t over the mesh (r_cc = sqrt(A^C / π) of a one-cell mesh); per_cell: each cell's. Fixed summation
 // order (mesh.tri_sums).
 template <class ExecutionSpace, class MemorySpace>
 double total_contact_area(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                          const ContactBuffers<MemorySpace>& contact) {
+                          const ContactBuffers<MemorySpace>& contact,
+                          std::vector<double>* per_cell = nullptr) {
   const auto v = contact.tri_contact_area;
   return fixed_order_sum(
-      "dcm::contact::area", space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) { return v(t); });
+      "dcm::contact::area", space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) { return v(t); }, per_cell);
 }
 
 // Σ_t F_t · n (N).
 template <class ExecutionSpace, class MemorySpace>
 double total_contact_load(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                          const ContactBuffers<MemorySpace>& contact) {
+                          const ContactBuffers<MemorySpace>& contact,
+                          std::vector<double>* per_cell = nullptr) {
   const auto v = contact.tri_load;
   return fixed_order_sum(
-      "dcm::contact::load", space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) { return v(t); });
+      "dcm::contact::load", space, mesh.tri_sums, KOKKOS_LAMBDA(const int t) { return v(t); }, per_cell);
 }
 
 }  // namespace dcm

@@ -86,14 +86,16 @@ void add_volume_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpac
 template <class ExecutionSpace, class MemorySpace, class KV>
 double volume_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                      const GeometryBuffers<MemorySpace>& geo, const VolumeRest<MemorySpace>& rest,
-                     const KV& k_v) {
+                     const KV& k_v, std::vector<double>* per_cell = nullptr) {
   const auto volume = geo.cell_volume;
   const auto rest_volume = rest.cell_volume;
   return fixed_order_sum(
-      "dcm::volume::energy", space, mesh.cell_sums, KOKKOS_LAMBDA(const int c) {
+      "dcm::volume::energy", space, mesh.cell_sums,
+      KOKKOS_LAMBDA(const int c) {
         const double d = volume(c) - rest_volume(c);
         return 0.5 * cell_value(k_v, c) * d * d / rest_volume(c);
-      });
+      },
+      per_cell);
 }
 
 }  // namespace dcm

@@ -35,9 +35,32 @@ class BatchStepper {
         v_prev_(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::batch::v_prev"), model.mesh().n_nodes),
         cell_h_(std::vector<double>(n_, 0.0), "dcm::batch::h") {}
 
+  const TimeStepSettings& settings() const { return settings_; }
   double time(int c) const { return t_.at(c); }
   double next_step(int c) const { return h_next_.at(c); }
   int n_cells() const { return n_; }
+
+  // Cell c's stepper state under TimeStepper's names (save_state there): a batch member's checkpoint is that
+  // of its one-cell run, and a one-cell BatchStepper restores a TimeStepper checkpoint.
+  void save_cell_state(Checkpoint& ck, const Model& model, int c) const {
+    ck.put("stepper.t", t_[c]);
+    ck.put("stepper.h_next", h_next_[c]);
+    ck.put("stepper.h_prev", h_prev_[c]);
+    ck.put("stepper.has_prev", has_prev_[c] ? 1.0 : 0.0);
+    ck.put("stepper.x_prev", model.cell_slice(x_prev_, c));
+    ck.put("stepper.v_prev", model.cell_slice(v_prev_, c));
+  }
+  // One-cell batches only (a restart continues one run).
+  void restore_state(const Checkpoint& ck) {
+    if (n_ != 1) throw std::logic_error("BatchStepper::restore_state: a checkpoint holds one cell");
+    t_[0] = ck.scalar("stepper.t");
+    h_next_[0] = ck.scalar("stepper.h_next");
+    h_prev_[0] = ck.scalar("stepper.h_prev");
+    has_prev_[0] = ck.scalar("stepper.has_prev") != 0;
+    const std::size_t size = 3 * x_prev_.extent(0);
+    from_host_vector(x_prev_, ck.array("stepper.x_prev", size));
+    from_host_vector(v_prev_, ck.array("stepper.v_prev", size));
+  }
 
   // One step of every cell c with h_cap[c] > 0, at most h_cap[c] long. observe(h) is called once, after the
   // velocities are known and before the positions move, with each cell's step (0: not stepping).
@@ -155,14 +178,16 @@ class BatchStepper {
           continue;
         }
         if (!(r[c].residual_norm < INFINITY))
-          throw NumericalError("cell " + std::to_string(c) +
-                               ": conjugate gradients diverged: the residual is not finite; the largest force is "
-                               "at node " +
-                               std::to_string(model.largest_force_node()));
+          throw NumericalError(
+              "cell " + std::to_string(c) +
+              ": conjugate gradients diverged: the residual is not finite; the largest force is "
+              "at node " +
+              std::to_string(model.largest_force_node()));
         if (rep[c].halvings >= settings_.max_halvings ||
             rep[c].unconverged_solves >= settings_.max_solve_halvings)
           throw NumericalError("cell " + std::to_string(c) + ": " + Model::unconverged_message(r[c], cg) +
-                               ", even with the time step halved " + std::to_string(rep[c].halvings) + " times");
+                               ", even with the time step halved " + std::to_string(rep[c].halvings) +
+                               " times");
         h[c] *= 0.5;
         ++rep[c].halvings;
         ++rep[c].unconverged_solves;

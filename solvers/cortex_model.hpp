@@ -199,6 +199,18 @@ class CortexModel {
     c.put("model.x", to_host_vector(mesh_.x));
     c.put("model.v", to_host_vector(velocity_));
   }
+  // The same for one cell of a batch, under the same names: a batch member's checkpoint is the checkpoint
+  // of the one-cell run.
+  void save_cell_state(Checkpoint& c, int cell) const {
+    c.put("model.x", cell_slice(mesh_.x, cell));
+    c.put("model.v", cell_slice(velocity_, cell));
+  }
+  // Flat [n][3] values of a cell's nodes.
+  std::vector<double> cell_slice(const Vector& v, int cell) const {
+    const auto all = to_host_vector(v);
+    const int b = mesh_.host_cell_node_begin.at(cell), e = mesh_.host_cell_node_begin.at(cell + 1);
+    return std::vector<double>(all.begin() + 3 * b, all.begin() + 3 * e);
+  }
   void restore_state(const Checkpoint& c) {
     const std::size_t size = 3 * static_cast<std::size_t>(mesh_.n_nodes);
     from_host_vector(mesh_.x, c.array("model.x", size));
@@ -259,13 +271,19 @@ class CortexModel {
   }
 
   // Power of the contact forces at the current velocity (W); 0 without a plane.
-  double contact_power() const {
-    return contact_ ? dcm::contact_power(space_, mesh_, params_.plane, *contact_, velocity_) : 0.0;
+  // per_cell (optional): each cell's value, for these and the contact area and load below.
+  double contact_power(std::vector<double>* per_cell = nullptr) const {
+    if (per_cell) per_cell->assign(mesh_.n_cells, 0.0);
+    return contact_ ? dcm::contact_power(space_, mesh_, params_.plane, *contact_, velocity_, per_cell) : 0.0;
   }
-  double contact_area() const {
-    return contact_ ? total_contact_area(space_, mesh_, *contact_) : 0.0;
-  }  // Σ A^C_t
-  double contact_load() const { return contact_ ? total_contact_load(space_, mesh_, *contact_) : 0.0; }  // N
+  double contact_area(std::vector<double>* per_cell = nullptr) const {  // Σ A^C_t
+    if (per_cell) per_cell->assign(mesh_.n_cells, 0.0);
+    return contact_ ? total_contact_area(space_, mesh_, *contact_, per_cell) : 0.0;
+  }
+  double contact_load(std::vector<double>* per_cell = nullptr) const {  // N
+    if (per_cell) per_cell->assign(mesh_.n_cells, 0.0);
+    return contact_ ? total_contact_load(space_, mesh_, *contact_, per_cell) : 0.0;
+  }
 
   // Geometry, then the total force on every node.
   void compute_forces() {
@@ -294,14 +312,24 @@ class CortexModel {
   }
 
   // Total energy for the current positions (calls update_geometry()).
-  double energy() {
+  // per_cell (optional): each cell's energy, the same terms added in the same order (a batch's cell gets
+  // the bits it gets alone).
+  double energy(std::vector<double>* per_cell = nullptr) {
     update_geometry(space_, mesh_, geo_, params_.h_min);
-    double e = external_energy(space_, mesh_.node_sums, external_, mesh_.x);
-    if (gravity_) e += external_energy(space_, mesh_.node_sums, *gravity_, mesh_.x);
-    if (bonds_) e += fene_pow_energy(space_, mesh_, *bonds_, bond_params_);
-    if (hinges_) e += bending_energy(space_, mesh_, *hinges_, k_b_);
-    if (area_) e += area_energy(space_, mesh_, geo_, *area_, k_area_local_, k_area_global_);
-    if (volume_) e += volume_energy(space_, mesh_, geo_, *volume_, k_volume_);
+    std::vector<double> term;
+    std::vector<double>* out = per_cell ? &term : nullptr;
+    const auto add = [&](double total, double& e) {
+      e += total;
+      if (per_cell)
+        for (int c = 0; c < mesh_.n_cells; ++c) (*per_cell)[c] += term[c];
+    };
+    if (per_cell) per_cell->assign(mesh_.n_cells, 0.0);
+    double e = external_energy(space_, mesh_.node_sums, external_, mesh_.x, per_cell);
+    if (gravity_) add(external_energy(space_, mesh_.node_sums, *gravity_, mesh_.x, out), e);
+    if (bonds_) add(fene_pow_energy(space_, mesh_, *bonds_, bond_params_, out), e);
+    if (hinges_) add(bending_energy(space_, mesh_, *hinges_, k_b_, out), e);
+    if (area_) add(area_energy(space_, mesh_, geo_, *area_, k_area_local_, k_area_global_, out), e);
+    if (volume_) add(volume_energy(space_, mesh_, geo_, *volume_, k_volume_, out), e);
     return e;
   }
 
@@ -326,9 +354,10 @@ class CortexModel {
       throw std::invalid_argument("solve_velocity: one step per cell expected");
     const bool with_dt = dt_cells[0] > 0;
     for (const double h : dt_cells)
-      if ((h > 0) != with_dt) throw std::invalid_argument("solve_velocity: steps must be all positive or all 0");
+      if ((h > 0) != with_dt)
+        throw std::invalid_argument("solve_velocity: steps must be all positive or all 0");
     dt_.assign(dt_cells);
-    const double dt = with_dt ? 1.0 : 0.0;                   // only its sign is used below
+    const double dt = with_dt ? 1.0 : 0.0;  // only its sign is used below
     const bool implicit_bonds = dt > 0 && params_.implicit_bonds && bonds_.has_value();
     if (implicit_bonds) {
       if (friction_.bond_stiffness_dt.extent(0) == 0)
@@ -461,11 +490,15 @@ class CortexModel {
   }
 
   // vᵀ Γ v: the power dissipated by the friction (W), for the energy balance.
-  double dissipation() {
+  double dissipation(std::vector<double>* per_cell = nullptr) {
     FrictionOperator<Mem> gamma = friction_;  // Γ alone, without the implicit bond stiffness
     gamma.bond_stiffness_dt = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
     apply_friction(space_, mesh_, gamma, velocity_, cg_.q);
-    return cg_detail::dot(space_, cg_.sums, velocity_, cg_.q, "dcm::model::dissipation");
+    if (!per_cell) return cg_detail::dot(space_, cg_.sums, velocity_, cg_.q, "dcm::model::dissipation");
+    cg_detail::segment_dots(space_, cg_.sums, velocity_, cg_.q, *per_cell, "dcm::model::dissipation");
+    double total = 0;  // the cells' sums in order: what dot() returns
+    for (const double d : *per_cell) total += d;
+    return total;
   }
 
  private:

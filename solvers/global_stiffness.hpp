@@ -43,7 +43,8 @@ void update_global_stiffness(const ExecutionSpace& space, const MeshBuffers<Memo
                              const GeometryBuffers<MemorySpace>& geo,
                              const Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace>& rest_area,
                              const Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace>& rest_volume,
-                             const KD& k_d, const KV& k_v, const DT& dt, const GlobalStiffness<MemorySpace>& g) {
+                             const KD& k_d, const KV& k_v, const DT& dt,
+                             const GlobalStiffness<MemorySpace>& g) {
   const auto x = mesh.x;
   const auto tri = mesh.tri;
   const auto offsets = mesh.node_tri_offsets;

@@ -85,6 +85,7 @@ double dot(const ExecutionSpace& space, const SumPlan<MemorySpace>& plan, const 
 template <class ExecutionSpace, class MemorySpace, class Vector>
 void segment_dots(const ExecutionSpace& space, const SumPlan<MemorySpace>& plan, const Vector& a,
                   const Vector& b, std::vector<double>& out, const char* label = "dcm::cg::dot") {
+  out.resize(plan.n_segments);
   segmented_sum<1>(
       label, space, plan,
       KOKKOS_LAMBDA(const int i, double(&acc)[1]) {

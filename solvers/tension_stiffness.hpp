@@ -51,7 +51,8 @@ void update_tension_stiffness(const ExecutionSpace& space, const MeshBuffers<Mem
         const int c = tri_cell(t);
         const double sigma = cell_value(k_a, c) * (area(t) - rest_tri(t)) / rest_tri(t) +
                              cell_value(k_d, c) * (cell_area(c) - rest_cell(c)) / rest_cell(c);
-        const double w = (sigma > 0 && area(t) > 0) ? math::sqrt(cell_value(dt_cells, c) * sigma / (4 * area(t))) : 0.0;
+        const double w =
+            (sigma > 0 && area(t) > 0) ? math::sqrt(cell_value(dt_cells, c) * sigma / (4 * area(t))) : 0.0;
         for (int k = 0; k < 3; ++k) {
           const Real3 e = load3(x, tri(t, (k + 2) % 3)) - load3(x, tri(t, (k + 1) % 3));  // opposite corner k
           edge(t, k, 0) = w * e.x;

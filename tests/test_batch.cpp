@@ -178,8 +178,9 @@ TEST(Batch, EachCellTakesItsOwnAdaptiveStepsAsAlone) {
   EXPECT_NE(alone_h[0].size(), alone_h[1].size()) << "the cells take different numbers of steps";
   EXPECT_GT(alone_rejections[0] + alone_rejections[1] + alone_halvings[0] + alone_halvings[1], 0)
       << "a rejection or halving is exercised";
-  std::printf("  steps %zu / %zu, rejections %d / %d, halvings %d / %d\n", alone_h[0].size(), alone_h[1].size(),
-              alone_rejections[0], alone_rejections[1], alone_halvings[0], alone_halvings[1]);
+  std::printf("  steps %zu / %zu, rejections %d / %d, halvings %d / %d\n", alone_h[0].size(),
+              alone_h[1].size(), alone_rejections[0], alone_rejections[1], alone_halvings[0],
+              alone_halvings[1]);
 }
 
 TEST(Batch, CellsThatNeedDifferentKernelsCannotShareABatch) {

@@ -2,11 +2,12 @@
 """scan: a parameter scan of spread runs (the paper's Figure 5 kind), described by a scan file.
 
 Every member is a spread run of its own, run by a pool of processes (--jobs at a time, each with --threads OpenMP
-threads). Started by mpirun (mpirun -np P scan ...), the ranks share the members out (rank 0 hands them out one at
-a time), each rank runs its share with its own pool, and rank 0 writes the one set of outputs. The batched engine
-(many cells in one kernel launch) is not done (docs/SCANS.md).
+threads). With --chunk N up to N members run as one batch (spread --batch: the members are cells of one model,
+one kernel launch for all, each member's outputs the same as alone; docs/SCANS.md); a batch that fails runs its
+members again one by one. Started by mpirun (mpirun -np P scan ...), the ranks share the members out (rank 0
+hands them out on request), each rank runs its share with its own pool, and rank 0 writes the one set of outputs.
 
-  scan SCAN.toml [--out DIR] [--jobs N] [--threads T] [--dry-run] [--no-plot] [--quiet]
+  scan SCAN.toml [--out DIR] [--jobs N] [--threads T] [--chunk N] [--dry-run] [--no-plot] [--quiet]
 
 Outputs in DIR (default out/<scan name>): members/<id>/ (each member's spread output), summary.csv (one row per
 member: id, status, the swept keys, the summary values), scan.h5 (a group per member: its parameters and
@@ -240,6 +241,8 @@ def prepare(a):
     """Checks the arguments and every member's scene, writes scan.json; returns (scan, out). Raises ScanError."""
     if a.jobs < 0 or a.jobs > 1024:
         raise ScanError(f"--jobs = {a.jobs} is out of range: allowed 1 .. 1024 (0: the number of cores)")
+    if a.chunk < 1 or a.chunk > 100000:
+        raise ScanError(f"--chunk = {a.chunk} is out of range: allowed 1 .. 100000")
     if a.threads < 0 or a.threads > 1024:
         raise ScanError(f"--threads = {a.threads} is out of range: allowed 1 .. 1024 (0: cores / members run at once)")
     scan = load_scan(a.scan_file)
@@ -262,14 +265,30 @@ def prepare(a):
 
 
 def run_members(a, out, next_member, serve, jobs, threads, say):
-    """Runs members as spread processes, jobs at a time, until next_member() returns None or a signal arrives.
-    serve() is called while waiting (rank 0 answers the other ranks there). Returns ({id: status}, stopped)."""
+    """Runs members as spread processes, jobs at a time, until next_member() returns None or a signal arrives;
+    with a.chunk > 1 up to a.chunk new members share one process (spread --batch). serve() is called while waiting
+    (rank 0 answers the other ranks there). Returns ({id: status}, stopped)."""
     env = dict(os.environ, OMP_NUM_THREADS=str(threads), OMP_PROC_BIND="false")
     for k in [k for k in env if k.startswith(("OMPI_", "PMIX_", "PMI_"))]:
         del env[k]  # the members are plain programs, not MPI ranks
     running, signalled, status = {}, set(), {}
     stop = False
     exhausted = False
+    alone = []  # members of a failed batch: each runs again by itself
+    batches = os.path.join(out, "batches")
+
+    def take():
+        return alone.pop(0) if alone else next_member()
+
+    def launch(ms, cmd, log_path):
+        for m in ms:
+            mdir = os.path.join(out, "members", m["id"])
+            os.makedirs(mdir, exist_ok=True)
+            with open(os.path.join(mdir, "member.json"), "w") as f:
+                json.dump({k: v for k, v in m.items() if k != "base"}, f, indent=1)
+        log = open(log_path, "w")
+        key = ms[0]["id"]
+        running[key] = (subprocess.Popen(cmd, env=env, stdout=log, stderr=subprocess.STDOUT), ms, time.time(), log)
 
     def on_signal(sig, frame):
         nonlocal stop
@@ -278,35 +297,64 @@ def run_members(a, out, next_member, serve, jobs, threads, say):
     signal.signal(signal.SIGTERM, on_signal)
     while (not exhausted and not stop) or running:
         while not exhausted and not stop and len(running) < jobs:
-            m = next_member()
-            if m is None:
-                exhausted = True
-                break
-            mdir = os.path.join(out, "members", m["id"])
-            state = member_state(mdir, m)  # on this rank's file system
-            if state == "done":
-                status[m["id"]] = "done"
-                continue
-            if state == "resume":
-                cmd = [a.spread, "--restart", os.path.join(mdir, "checkpoint.h5"), "--quiet", "--no-plot"]
-            else:
+            batch = []  # new members that run together
+            while len(batch) < max(1, a.chunk):
+                from_batch = bool(alone)
+                m = take()
+                if m is None:
+                    exhausted = True
+                    break
+                mdir = os.path.join(out, "members", m["id"])
+                state = member_state(mdir, m)  # on this rank's file system
+                if state == "done":
+                    status[m["id"]] = "done"
+                    continue
+                if state == "resume":  # a restart continues one run
+                    launch([m], [a.spread, "--restart", os.path.join(mdir, "checkpoint.h5"), "--quiet", "--no-plot"],
+                           os.path.join(mdir, "spread.log"))
+                    break
                 shutil.rmtree(mdir, ignore_errors=True)
-                cmd = spread_cmd(a.spread, {"base": m["base"]}, m, mdir, ["--quiet", "--no-plot"])
-            os.makedirs(mdir, exist_ok=True)
-            with open(os.path.join(mdir, "member.json"), "w") as f:
-                json.dump({k: v for k, v in m.items() if k != "base"}, f, indent=1)
-            log = open(os.path.join(mdir, "spread.log"), "w")
-            running[m["id"]] = (subprocess.Popen(cmd, env=env, stdout=log, stderr=subprocess.STDOUT), m, time.time(), log)
+                if from_batch:  # again by itself
+                    launch([m], spread_cmd(a.spread, {"base": m["base"]}, m, mdir, ["--quiet", "--no-plot"]),
+                           os.path.join(mdir, "spread.log"))
+                    break
+                batch.append(m)
+            if len(batch) == 1:
+                m = batch[0]
+                mdir = os.path.join(out, "members", m["id"])
+                launch([m], spread_cmd(a.spread, {"base": m["base"]}, m, mdir, ["--quiet", "--no-plot"]),
+                       os.path.join(mdir, "spread.log"))
+            elif batch:
+                os.makedirs(batches, exist_ok=True)
+                listing = os.path.join(batches, batch[0]["id"] + ".txt")
+                with open(listing, "w") as f:
+                    for m in batch:
+                        words = spread_cmd("", {"base": m["base"]}, m, os.path.join(out, "members", m["id"]))[1:]
+                        f.write(" ".join('"' + w + '"' for w in words) + "\n")
+                launch(batch, [a.spread, "--batch", listing, "--quiet", "--no-plot"],
+                       os.path.join(batches, batch[0]["id"] + ".log"))
         serve(stop)
         time.sleep(0.05)
-        for mid, (p, m, started, log) in list(running.items()):
+        for key, (p, ms, started, log) in list(running.items()):
             rc = p.poll()
             if rc is None:
                 continue
             log.close()
-            del running[mid]
-            status[mid] = {0: "done", 3: "failed (numerical)", 130: "interrupted"}.get(rc, f"failed (exit {rc})")
-            say(f"{mid} {m['label']}: {status[mid]} in {time.time() - started:.1f} s")
+            del running[key]
+            result = {0: "done", 3: "failed (numerical)", 130: "interrupted"}.get(rc, f"failed (exit {rc})")
+            if len(ms) > 1:
+                for m in ms:  # each member's log: the batch's
+                    shutil.copyfile(log.name, os.path.join(out, "members", m["id"], "spread.log"))
+                if rc not in (0, 130):
+                    say(f"batch {', '.join(m['id'] for m in ms)}: {result} in {time.time() - started:.1f} s; "
+                        f"its members run again one by one")
+                    alone.extend(ms)
+                    exhausted = False
+                    continue
+            for m in ms:
+                status[m["id"]] = result
+                say(f"{m['id']} {m['label']}: {result} in {time.time() - started:.1f} s"
+                    + (f" (batch of {len(ms)})" if len(ms) > 1 else ""))
         if stop:  # each running member once: it writes its checkpoint and stops
             for mid, (p, *_) in running.items():
                 if mid not in signalled and p.poll() is None:
@@ -339,6 +387,8 @@ def main():
                     help="members run at once (per MPI rank; default: the cores, shared among the ranks on a machine)")
     ap.add_argument("--threads", type=int, default=0,
                     help="OpenMP threads per member (default: cores / members run at once)")
+    ap.add_argument("--chunk", type=int, default=1,
+                    help="members run as one batch (spread --batch; default 1: each member its own process)")
     ap.add_argument("--dry-run", action="store_true", help="list the members and their --set arguments, run nothing")
     ap.add_argument("--no-plot", action="store_true", help="do not draw r_cc_grid.png")
     ap.add_argument("--quiet", action="store_true", help="print only errors")

@@ -14,8 +14,15 @@
 //                `spread --restart <out>/checkpoint.h5` continues bit for bit (docs/CHECKPOINTS.md)
 // Ctrl-C (SIGINT) or SIGTERM: the loop stops after the current step, a checkpoint is written, the files are
 // closed and valid, the summary says "interrupted": true; exit code 130.
+//
+// A batch (`spread --batch MEMBERS.txt`, one member per line: `[SCENE.toml] [--set KEY=VALUE]... --out DIR`):
+// the members are cells of one model (the batched engine, docs/SCANS.md): one launch per kernel for all,
+// per-cell constants, CG and time steps. Each member's folder gets exactly the files its run alone writes,
+// with the same numbers (wall_s excepted: the batch's). Members must need the same kernels and settings
+// (mesh size, solver and time-step options); the first difference is named.
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -24,6 +31,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -36,7 +44,7 @@
 #include "core/host_copy.hpp"
 #include "core/json_writer.hpp"
 #include "core/kokkos_compat.hpp"
-#include "solvers/time_stepper.hpp"
+#include "solvers/batch_stepper.hpp"
 
 namespace dcm {
 namespace {
@@ -55,6 +63,7 @@ struct SpreadOptions {
   std::string restart;      // checkpoint to continue from
   long long max_steps = 0;  // stop after this many steps (counted from the run's start), 0: no limit
   bool check = false;       // validate the scene and options, write nothing, run nothing
+  std::string batch;        // file with one member per line: run them as one batch
 };
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -138,16 +147,60 @@ Scene spread_scene(const AppOptions& options, const SpreadOptions& so, const Che
   return scene;
 }
 
-void run(const AppOptions& options, const SpreadOptions& so) {
-  std::signal(SIGINT, on_signal);  // from the start: a stop during the set-up ends after the first step
-  std::signal(SIGTERM, on_signal);
-  std::optional<Checkpoint> restart;
-  if (!so.restart.empty()) {
-    restart = read_checkpoint(so.restart);
-    if (restart->text("app") != "spread")
-      throw IoError(so.restart + ": a checkpoint of '" + restart->text("app") + "', not of spread");
+// What the run of one member has done so far: everything a restart needs besides the model and the stepper.
+struct Progress {
+  double step = 0, next_figure = 0, next_frame = 0, next_sample = 0, cg_total = 0, cg_max = 0;
+  double worst_residual = 0, worst_residual_scale = 0, halved = 0, rejected = 0, h_min = INFINITY, h_max = 0;
+  double wall_before = 0;             // wall seconds of earlier segments of a restarted run
+  std::array<double*, 13> fields() {  // in the checkpoint's app.progress order
+    return {&step,   &next_figure,    &next_frame,           &next_sample, &cg_total,
+            &cg_max, &worst_residual, &worst_residual_scale, &halved,      &rejected,
+            &h_min,  &h_max,          &wall_before};
   }
-  const Scene scene = spread_scene(options, so, restart ? &*restart : nullptr);
+};
+
+// One spreading run: its scene and settings, its cell in the model, its output files and its progress.
+struct Member {
+  AppOptions options;
+  SpreadOptions so;
+  std::optional<Checkpoint> restart;
+  Scene scene;
+  HostMesh mesh;  // placed: its lowest node start_gap_m above the plane
+  MechanicsParams params;
+  TimeStepSettings steps;
+  CgSettings cg;
+  double plane_z = 0, dt = 0, t_end = 0, frame_every = 0, per_decade = 0, checkpoint_every = 0;
+  std::string out_dir, checkpoint_path, csv_tmp;
+  int cell = 0, first_node = 0, n = 0;
+  Progress p;
+  std::vector<double> ts, rs, areas_c, heights;  // the series rows (HDF5 /series)
+  std::string csv_text =
+      "t_s,r_cc_m,contact_area_m2,area_m2,volume_m3,cg_iterations,dt_s,height_m,contact_load_N,"
+      "elastic_energy_J,dE_dt_W,contact_power_W,dissipation_W,energy_residual_W\n";
+  int frames_before = 0;
+  std::ofstream csv;
+  std::unique_ptr<H5Output> h5;
+  bool last = false, interrupted = false, stopped_at_max_steps = false, done = false;
+  long long steps_before = 0;
+  std::chrono::steady_clock::time_point last_checkpoint;
+  // the step in progress
+  double t = 0, h_cap = 0, e0 = 0, pc = 0, dis = 0;
+  long long index = 0;
+  bool sample = false;
+};
+
+const std::vector<double> kFigureTimes = {0.1, 0.35, 0.9};  // paper Figures 1 and 6
+
+// The scene, its checks and the placed cell of one member; nothing is written.
+void prepare_member(Member& m) {
+  const SpreadOptions& so = m.so;
+  if (!so.restart.empty()) {
+    m.restart = read_checkpoint(so.restart);
+    if (m.restart->text("app") != "spread")
+      throw IoError(so.restart + ": a checkpoint of '" + m.restart->text("app") + "', not of spread");
+  }
+  m.scene = spread_scene(m.options, so, m.restart ? &*m.restart : nullptr);
+  const Scene& scene = m.scene;
   if (!scene.get_bool("contact.plane"))
     throw SceneError("contact.plane = false: spread needs the substrate plane (set contact.plane = true)");
   if (!(so.early_from_s > 0 && so.early_to_s > so.early_from_s))
@@ -182,267 +235,128 @@ void run(const AppOptions& options, const SpreadOptions& so) {
                        "node, " +
                        g3(norm) + " N in norm, needs a tolerance <= " + g3(1e-3 * norm) + " N");
   }
-  const double dt = scene.get_real("time.dt_s"), t_end = scene.get_real("time.t_end_s");
-  const TimeStepSettings step_settings = steps_from_scene(scene);
-  if (so.check) {  // everything above would have stopped a bad run; nothing is written
-    std::printf("spread: scene %s: ok (checked, nothing written)\n", scene.name().c_str());
-    return;
-  }
-  const std::string out = restart
-                              ? std::filesystem::path(so.restart).parent_path().lexically_normal().string()
-                              : prepare_output_dir(options, scene);
-  const std::string out_dir = out.empty() ? "." : out;
-  KokkosSession kokkos(options.threads);
-  const auto wall0 = std::chrono::steady_clock::now();
-
-  // The cell, its lowest node `gap` above the plane.
-  HostMesh mesh = cell_mesh_from_scene(scene);
-  const double plane_z = scene.get_real("contact.plane_z_m");
+  m.dt = scene.get_real("time.dt_s");
+  m.t_end = scene.get_real("time.t_end_s");
+  m.steps = steps_from_scene(scene);
+  m.cg = cg_settings_from_scene(scene);
+  m.frame_every = scene.get_real("output.frame_every_s");
+  m.per_decade = static_cast<double>(scene.get_int("output.series_per_decade"));
+  m.checkpoint_every = scene.get_real("output.checkpoint_every_s");
+  m.plane_z = scene.get_real("contact.plane_z_m");
+  m.mesh = cell_mesh_from_scene(scene);
   double zmin = INFINITY;
-  for (const auto& x : mesh.nodes) zmin = std::min(zmin, x[2]);
-  for (auto& x : mesh.nodes) x[2] += plane_z + gap - zmin;
-  const MechanicsParams params = mechanics_from_scene(scene);
-  CortexModel<Exec> model(Exec(), {HostCell(mesh)}, params);
-  const int n = model.mesh().n_nodes;
-  NodeFields<Exec::memory_space> fields(n);
-  TimeStepper<Exec> stepper(n, step_settings);
+  for (const auto& x : m.mesh.nodes) zmin = std::min(zmin, x[2]);
+  for (auto& x : m.mesh.nodes) x[2] += m.plane_z + gap - zmin;
+  m.params = mechanics_from_scene(scene);
+}
 
-  const long long steps = std::llround(t_end / dt);  // fixed steps; adaptive ones are counted as they go
-  const double frame_every = scene.get_real("output.frame_every_s");
-  const double per_decade = static_cast<double>(scene.get_int("output.series_per_decade"));
-  const double checkpoint_every = scene.get_real("output.checkpoint_every_s");
-  const std::string checkpoint_path = out_dir + "/checkpoint.h5";
-  const CgSettings cg = cg_settings_from_scene(scene);
+// Why member b cannot join member a's batch ("" if it can): what is not per cell must be the same.
+std::string batch_difference(const Member& a, const Member& b) {
+  const auto g = [](double v) { return detail::format_real(v); };
+  if (a.mesh.nodes.size() != b.mesh.nodes.size())
+    return "mesh.nodes = " + std::to_string(b.mesh.nodes.size()) + " (the batch has " +
+           std::to_string(a.mesh.nodes.size()) + "; a batch shares one mesh size)";
+  const struct {
+    const char* key;
+    double x, y;
+  } reals[] = {{"time.dt_s", a.steps.dt, b.steps.dt},
+               {"time.adaptive", a.steps.adaptive ? 1.0 : 0.0, b.steps.adaptive ? 1.0 : 0.0},
+               {"time.error_tol_m", a.steps.error_tol_m, b.steps.error_tol_m},
+               {"time.dt_min_s", a.steps.dt_min, b.steps.dt_min},
+               {"time.dt_max_s", a.steps.dt_max, b.steps.dt_max},
+               {"solver.cg_abs_tol_N", a.cg.abs_tol, b.cg.abs_tol},
+               {"solver.cg_rel_tol", a.cg.rel_tol, b.cg.rel_tol},
+               {"solver.cg_max_iterations", static_cast<double>(a.cg.max_iterations),
+                static_cast<double>(b.cg.max_iterations)}};
+  for (const auto& r : reals)
+    if (r.x != r.y) return std::string(r.key) + " = " + g(r.y) + " (the batch has " + g(r.x) + ")";
+  const std::string why = batch_mismatch(a.params, b.params);
+  return why.empty() ? "" : "the scene: " + why;
+}
 
-  // What the run has done so far: everything a restart needs besides the model and the stepper.
-  const std::vector<double> figure_times = {0.1, 0.35, 0.9};  // paper Figures 1 and 6
-  struct Progress {
-    double step = 0, next_figure = 0, next_frame = 0, next_sample = 0, cg_total = 0, cg_max = 0;
-    double worst_residual = 0, worst_residual_scale = 0, halved = 0, rejected = 0, h_min = INFINITY,
-           h_max = 0;
-    double wall_before = 0;  // wall seconds of earlier segments of a restarted run
-  } p;
-  std::vector<double> ts, rs, areas_c, heights;  // the series rows (HDF5 /series)
-  std::string csv_text =
-      "t_s,r_cc_m,contact_area_m2,area_m2,volume_m3,cg_iterations,dt_s,height_m,contact_load_N,"
-      "elastic_energy_J,dE_dt_W,contact_power_W,dissipation_W,energy_residual_W\n";
-  int frames_before = 0;
-  if (restart) {
-    const Checkpoint& c = *restart;
-    model.restore_state(c);
-    stepper.restore_state(c);
-    double* fields_of_p[] = {&p.step,       &p.next_figure, &p.next_frame,     &p.next_sample,
-                             &p.cg_total,   &p.cg_max,      &p.worst_residual, &p.worst_residual_scale,
-                             &p.halved,     &p.rejected,    &p.h_min,          &p.h_max,
-                             &p.wall_before};
-    const std::vector<double>& saved = c.array("app.progress", std::size(fields_of_p));
-    for (std::size_t i = 0; i < std::size(fields_of_p); ++i) *fields_of_p[i] = saved[i];
-    ts = c.array("app.t_s");
-    rs = c.array("app.r_cc_m", ts.size());
-    areas_c = c.array("app.contact_area_m2", ts.size());
-    heights = c.array("app.height_m", ts.size());
-    csv_text = c.text("app.series_csv");
-    frames_before = static_cast<int>(c.scalar("app.frames"));
-  }
+using Model = CortexModel<Exec>;
+using Stepper = BatchStepper<Exec>;
 
-  std::vector<int> tri, node_cell(n, 0);
-  for (const Tri& t : mesh.triangles) tri.insert(tri.end(), t.begin(), t.end());
-  std::optional<H5Output> h5_storage;
-  if (restart) {
-    h5_storage.emplace(out_dir + "/spread.h5", H5Output::Resume{frames_before});
-  } else {
-    h5_storage.emplace(out_dir + "/spread.h5");
-    h5_storage->write_text("scene", scene.to_toml());
-    h5_storage->write_mesh(to_host_vector(model.positions()).data(), n, tri.data(),
-                           static_cast<int>(mesh.triangles.size()), node_cell.data());
-  }
-  H5Output& h5 = *h5_storage;
-  const auto append_h5_row = [&](std::size_t i) {
-    h5.append_series(
-        {{"t_s", ts[i]}, {"r_cc_m", rs[i]}, {"contact_area_m2", areas_c[i]}, {"height_m", heights[i]}});
+void write_frame(Member& m, Model& model, NodeFields<Exec::memory_space>& fields, double t) {
+  model.node_fields(fields);
+  const auto slice = [&](const Kokkos::View<double*, Kokkos::LayoutRight, Exec::memory_space>& v) {
+    const auto all = to_host_vector(v);
+    return std::vector<double>(all.begin() + m.first_node, all.begin() + m.first_node + m.n);
   };
-  for (std::size_t i = 0; i < ts.size(); ++i) append_h5_row(i);
-  const std::string csv_tmp = out_dir + "/series.csv.part";
-  std::ofstream csv(csv_tmp, std::ios::trunc);
-  csv << csv_text;
-  if (!csv) throw IoError(csv_tmp + ": cannot write");
-  if (!options.quiet) {
-    if (restart)
-      std::printf(
-          "dcm spread: restart from %s at t = %.6g s (step %lld), scene '%s', %d nodes, t_end = %.3g s; %s\n",
-          so.restart.c_str(), stepper.time(), static_cast<long long>(p.step), scene.name().c_str(), n, t_end,
-          kokkos_description().c_str());
-    else
-      std::printf("dcm spread: scene '%s', %d nodes, dt = %.3g s, t_end = %.3g s (%lld steps); %s\n",
-                  scene.name().c_str(), n, dt, t_end, steps, kokkos_description().c_str());
-  }
+  const auto x = model.cell_slice(model.positions(), m.cell);
+  const auto tension = slice(fields.tension), stretch = slice(fields.stretch);
+  const auto fn = slice(fields.normal_force), pn = slice(fields.normal_pressure);
+  m.h5->write_frame(t, x.data(),
+                    {{"cortex_tension_J_per_m2", 1, tension.data()},
+                     {"stretch", 1, stretch.data()},
+                     {"normal_force_N", 1, fn.data()},
+                     {"normal_pressure_Pa", 1, pn.data()}});
+}
 
-  auto write_frame = [&](double t) {
-    model.node_fields(fields);
-    const auto x = to_host_vector(model.positions());
-    const auto tension = to_host_vector(fields.tension), stretch = to_host_vector(fields.stretch);
-    const auto fn = to_host_vector(fields.normal_force), pn = to_host_vector(fields.normal_pressure);
-    h5.write_frame(t, x.data(),
-                   {{"cortex_tension_J_per_m2", 1, tension.data()},
-                    {"stretch", 1, stretch.data()},
-                    {"normal_force_N", 1, fn.data()},
-                    {"normal_pressure_Pa", 1, pn.data()}});
-  };
-  // A checkpoint at a step boundary: model, stepper, and what the run has written (docs/CHECKPOINTS.md).
-  auto write_checkpoint_now = [&] {
-    Checkpoint c;
-    c.put_text("app", "spread");
-    c.put_text("scene", scene.to_toml());
-    model.save_state(c);
-    stepper.save_state(c);
-    c.put("app.progress", {p.step, p.next_figure, p.next_frame, p.next_sample, p.cg_total, p.cg_max,
-                           p.worst_residual, p.worst_residual_scale, p.halved, p.rejected, p.h_min, p.h_max,
-                           p.wall_before + seconds_since(wall0)});
-    c.put("app.t_s", ts);
-    c.put("app.r_cc_m", rs);
-    c.put("app.contact_area_m2", areas_c);
-    c.put("app.height_m", heights);
-    c.put_text("app.series_csv", csv_text);
-    c.put("app.frames", static_cast<double>(h5.frames()));
-    h5.flush();
-    write_checkpoint(checkpoint_path, c);
-  };
-  auto last_checkpoint = std::chrono::steady_clock::now();
-  // Numerical trouble ends the run (exit 3) with the files closed: what was done stays readable, no NaN row.
-  auto stop_on_numerical_trouble = [&](const std::string& what) {
-    h5.close();
-    csv.close();
-    std::rename(csv_tmp.c_str(), (out_dir + "/series.csv").c_str());
-    throw NumericalError(what + " — try a smaller time.dt_s or time.adaptive = true" +
-                         (std::filesystem::exists(checkpoint_path)
-                              ? "; the last checkpoint is " + checkpoint_path
-                              : std::string()));
-  };
+// A checkpoint at a step boundary: the member's cell, its stepper state, and what it has written
+// (docs/CHECKPOINTS.md): the checkpoint of the same run alone.
+void write_checkpoint_now(Member& m, const Model& model, const Stepper& stepper, double wall) {
+  Checkpoint c;
+  c.put_text("app", "spread");
+  c.put_text("scene", m.scene.to_toml());
+  model.save_cell_state(c, m.cell);
+  stepper.save_cell_state(c, model, m.cell);
+  std::vector<double> progress;
+  for (double* f : m.p.fields()) progress.push_back(f == &m.p.wall_before ? m.p.wall_before + wall : *f);
+  c.put("app.progress", progress);
+  c.put("app.t_s", m.ts);
+  c.put("app.r_cc_m", m.rs);
+  c.put("app.contact_area_m2", m.areas_c);
+  c.put("app.height_m", m.heights);
+  c.put_text("app.series_csv", m.csv_text);
+  c.put("app.frames", static_cast<double>(m.h5->frames()));
+  m.h5->flush();
+  write_checkpoint(m.checkpoint_path, c);
+}
 
-  // Forward Euler at the scene's fixed Δt (the paper's) or with adaptive, error-controlled steps; a step
-  // that would take a bond too close to d_max is taken again with half the step (solvers/time_stepper.hpp).
-  auto last_progress = std::chrono::steady_clock::now();
-  bool interrupted = false, stopped_at_max_steps = false;
-  const long long steps_before = static_cast<long long>(p.step);
-  bool last = stepper.time() >= t_end * (1 - 1e-12);
-  while (!last) {
-    const double t = stepper.time();
-    const long long index = static_cast<long long>(p.step);
-    // The last step lands on t_end (a fixed-step run's last step may be up to 1.5 Δt long, as before).
-    const double remaining = t_end - t;
-    const double h_cap =
-        stepper.settings().adaptive ? remaining : (remaining < 1.5 * dt ? remaining : INFINITY);
-    double e0 = 0, pc = 0, dis = 0;
-    bool sample = false;
-    StepReport rep;
-    try {
-      rep = stepper.step(model, cg, h_cap, [&](double h_planned) {
-        const auto next_figure = static_cast<std::size_t>(p.next_figure);
-        if (t >= p.next_frame - 1e-12 ||
-            (next_figure < figure_times.size() && t >= figure_times[next_figure] - 1e-12)) {
-          write_frame(t);
-          while (p.next_frame <= t + 1e-12) p.next_frame += frame_every;
-          std::size_t f = next_figure;
-          while (f < figure_times.size() && figure_times[f] <= t + 1e-12) ++f;
-          p.next_figure = static_cast<double>(f);
-        }
-        sample = t >= p.next_sample || index < 10 || h_planned >= h_cap;
-        if (sample) {
-          e0 = model.energy();
-          pc = model.contact_power();
-          dis = model.dissipation();
-        }
-      });
-    } catch (const NumericalError& e) {
-      stop_on_numerical_trouble("step " + std::to_string(index) + " (t = " + std::to_string(stepper.time()) +
-                                " s): " + e.what());
-    }
-    p.step += 1;
-    const double h = rep.h;
-    last = stepper.time() >= t_end * (1 - 1e-12);
-    p.cg_total += rep.iterations;
-    p.cg_max = std::max(p.cg_max, static_cast<double>(rep.iterations));
-    p.halved += rep.halvings;
-    p.rejected += rep.rejections;
-    p.h_min = std::min(p.h_min, h);
-    p.h_max = std::max(p.h_max, h);
-    if (sample) {
-      // Energy balance of the step: (E(t+h) − E(t))/h against the contact power minus the dissipation.
-      const double e1 = model.energy(), de = (e1 - e0) / h, residual = de - (pc - dis);
-      p.worst_residual = std::max(p.worst_residual, std::fabs(residual));
-      p.worst_residual_scale = std::max(p.worst_residual_scale, std::fabs(dis) + std::fabs(pc));
-      const double area_c = model.contact_area();
-      if (!(area_c >= 0)) {  // not finite: the state is no longer a cell
-        const auto tri_area_c = to_host_vector(model.contact()->tri_contact_area);
-        const auto bad =
-            std::find_if(tri_area_c.begin(), tri_area_c.end(), [](double a) { return !(a >= 0); });
-        stop_on_numerical_trouble("step " + std::to_string(index) + " (t = " + std::to_string(t + h) +
-                                  " s): the contact area is " + detail::format_real(area_c) +
-                                  " m² (first at triangle " + std::to_string(bad - tri_area_c.begin()) + ")");
-      }
-      const double r_cc = std::sqrt(area_c / kPi);
-      const auto xh = to_host_vector(model.positions());
-      double ztop = -INFINITY;
-      for (int i = 0; i < n; ++i) ztop = std::max(ztop, xh[3 * i + 2]);
-      const double area = to_host_vector(model.geometry().cell_area)[0];
-      const double volume = to_host_vector(model.geometry().cell_volume)[0];
-      char line[512];
-      std::snprintf(line, sizeof line,
-                    "%.9g,%.9g,%.9g,%.9g,%.9g,%d,%.6g,%.9g,%.9g,%.12g,%.6g,%.6g,%.6g,%.6g\n", t + h, r_cc,
-                    area_c, area, volume, rep.iterations, h, ztop - plane_z, model.contact_load(), e1, de, pc,
-                    dis, residual);
-      csv << line;
-      csv_text += line;
-      ts.push_back(t + h);
-      rs.push_back(r_cc);
-      areas_c.push_back(area_c);
-      heights.push_back(ztop - plane_z);
-      append_h5_row(ts.size() - 1);
-      p.next_sample = (t + h) * std::pow(10.0, 1.0 / per_decade);
-    }
-    // Progress every 2 s of wall time, independent of the (log-spaced) series rows.
-    if (!options.quiet && seconds_since(last_progress) > 2.0) {
-      const double wall = seconds_since(wall0), rate = (p.step - steps_before) / wall;
-      std::printf("  t = %.4f s  r_cc = %.3f um  dt = %.2g s  CG %d it  %.0f steps/s  ETA %.0f s\n",
-                  stepper.time(), std::sqrt(model.contact_area() / kPi) * 1e6, h, rep.iterations, rate,
-                  (t_end - stepper.time()) / h / rate);
-      std::fflush(stdout);
-      last_progress = std::chrono::steady_clock::now();
-    }
-    stopped_at_max_steps = so.max_steps > 0 && p.step >= static_cast<double>(so.max_steps) && !last;
-    if (g_stop || stopped_at_max_steps) {
-      interrupted = g_stop && !last;
-      break;
-    }
-    if (checkpoint_every > 0 && seconds_since(last_checkpoint) > checkpoint_every) {
-      write_checkpoint_now();
-      last_checkpoint = std::chrono::steady_clock::now();
-    }
+// Numerical trouble ends the run (exit 3) with every member's files closed: what was done stays readable, no
+// NaN row.
+[[noreturn]] void stop_on_numerical_trouble(std::vector<Member>& ms, const std::string& what) {
+  for (Member& m : ms) {
+    if (m.done) continue;
+    m.h5->close();
+    m.csv.close();
+    std::rename(m.csv_tmp.c_str(), (m.out_dir + "/series.csv").c_str());
   }
-  // The final state: a checkpoint (a restart continues from here, e.g. with a longer t_end), then its frame.
-  write_checkpoint_now();
+  const Member& m = ms.front();
+  throw NumericalError(what + " — try a smaller time.dt_s or time.adaptive = true" +
+                       (ms.size() == 1 && std::filesystem::exists(m.checkpoint_path)
+                            ? "; the last checkpoint is " + m.checkpoint_path
+                            : std::string()));
+}
+
+// The end of a member's run: checkpoint, final frame, files closed, summary and plots.
+void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<Exec::memory_space>& fields,
+                   double wall_now) {
+  write_checkpoint_now(m, model, stepper, wall_now);
   model.compute_forces();
-  write_frame(stepper.time());
-  const double t = stepper.time();
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
-  csv.close();
-  std::rename(csv_tmp.c_str(), (out_dir + "/series.csv").c_str());
-  h5.close();
+  const double t = stepper.time(m.cell);
+  write_frame(m, model, fields, t);
+  m.csv.close();
+  std::rename(m.csv_tmp.c_str(), (m.out_dir + "/series.csv").c_str());
+  m.h5->close();
+  m.done = true;
 
-  const long long done = static_cast<long long>(p.step);
-  const auto x = to_host_vector(model.positions());
+  const long long done = static_cast<long long>(m.p.step);
+  const auto x = model.cell_slice(model.positions(), m.cell);
   double ztop = -INFINITY;
-  for (int i = 0; i < n; ++i) ztop = std::max(ztop, x[3 * i + 2]);
-  const CapFit cap = fit_cap(x, plane_z, false), cap_free = fit_cap(x, plane_z, true);
+  for (int i = 0; i < m.n; ++i) ztop = std::max(ztop, x[3 * i + 2]);
+  const CapFit cap = fit_cap(x, m.plane_z, false), cap_free = fit_cap(x, m.plane_z, true);
   int used = 0;
-  const double alpha = fit_exponent(ts, rs, so.early_from_s, so.early_to_s, used);
-  const double wall = p.wall_before + seconds_since(wall0);
+  const SpreadOptions& so = m.so;
+  const double alpha = fit_exponent(m.ts, m.rs, so.early_from_s, so.early_to_s, used);
+  const double wall = m.p.wall_before + wall_now;
+  const Progress& p = m.p;
   JsonObject summary;
-  summary.add("scene", scene.name())
-      .add("nodes", n)
-      .add("interrupted", interrupted)
-      .add("stopped_at_max_steps", stopped_at_max_steps)
+  summary.add("scene", m.scene.name())
+      .add("nodes", m.n)
+      .add("interrupted", m.interrupted)
+      .add("stopped_at_max_steps", m.stopped_at_max_steps)
       .add("restarted_from", so.restart)
       .add("t_end_s", t)
       .add("halved_steps", static_cast<long long>(p.halved))
@@ -450,7 +364,7 @@ void run(const AppOptions& options, const SpreadOptions& so) {
       .add("adaptive", stepper.settings().adaptive)
       .add("dt_min_taken_s", std::isfinite(p.h_min) ? p.h_min : 0.0)
       .add("dt_max_taken_s", p.h_max)
-      .add("r_cc_final_m", rs.empty() ? 0.0 : rs.back())
+      .add("r_cc_final_m", m.rs.empty() ? 0.0 : m.rs.back())
       .add("contact_angle_deg", cap.angle_deg)
       .add("cap_radius_m", cap.radius)
       .add("contact_angle_free_deg", cap_free.angle_deg)
@@ -458,39 +372,385 @@ void run(const AppOptions& options, const SpreadOptions& so) {
       .add("early_exponent", alpha)
       .add("early_window_s", std::vector<double>{so.early_from_s, so.early_to_s})
       .add("early_window_rows", used)
-      .add("height_final_m", ztop - plane_z)
+      .add("height_final_m", ztop - m.plane_z)
       .add("steps", done)
-      .add("dt_s", dt)
+      .add("dt_s", m.dt)
       .add("wall_s", wall)
       .add("mean_cg_iterations", done > 0 ? p.cg_total / done : 0.0)
       .add("max_cg_iterations", static_cast<long long>(p.cg_max))
       .add("energy_residual_max_W", p.worst_residual)
       .add("energy_residual_relative",
            p.worst_residual_scale > 0 ? p.worst_residual / p.worst_residual_scale : 0.0)
-      .add("checkpoint", checkpoint_path);
-  summary.write(out_dir + "/summary.json");
-  if (!options.quiet)
+      .add("checkpoint", m.checkpoint_path);
+  summary.write(m.out_dir + "/summary.json");
+  if (!m.options.quiet)
     std::printf(
-        "  r_cc = %.3f um, contact angle %.1f deg (free membrane %.1f), early exponent %.3f (t in [%g, %g] "
+        "  %sr_cc = %.3f um, contact angle %.1f deg (free membrane %.1f), early exponent %.3f (t in [%g, %g] "
         "s), height %.3f um; "
         "%lld steps in %.1f s, mean CG %.1f\n",
-        (rs.empty() ? 0.0 : rs.back()) * 1e6, cap.angle_deg, cap_free.angle_deg, alpha, so.early_from_s,
-        so.early_to_s, (ztop - plane_z) * 1e6, done, wall, done > 0 ? p.cg_total / done : 0.0);
-  if (so.plot && !interrupted && !stopped_at_max_steps) {
+        m.cell > 0 || !m.so.batch.empty() ? (m.out_dir + ": ").c_str() : "",
+        (m.rs.empty() ? 0.0 : m.rs.back()) * 1e6, cap.angle_deg, cap_free.angle_deg, alpha, so.early_from_s,
+        so.early_to_s, (ztop - m.plane_z) * 1e6, done, wall, done > 0 ? p.cg_total / done : 0.0);
+  if (so.plot && !m.interrupted && !m.stopped_at_max_steps) {
     const std::string cmd =
-        std::string(DCM_PYTHON3) + " '" + DCM_SOURCE_DIR + "/scripts/plot_spread.py' '" + out_dir + "'";
+        std::string(DCM_PYTHON3) + " '" + DCM_SOURCE_DIR + "/scripts/plot_spread.py' '" + m.out_dir + "'";
     if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "spread: plotting failed (%s)\n", cmd.c_str());
   }
-  if (interrupted)
-    throw AppInterrupted("interrupted at t = " + std::to_string(t) + " s; " + out_dir +
-                         "/spread.h5, series.csv and summary.json hold what was done; continue with: spread "
-                         "--restart " +
-                         checkpoint_path);
+}
+
+// Runs the members as one batch (one member: the ordinary run). Forward Euler at the scene's fixed Δt (the
+// paper's) or with adaptive, error-controlled steps, each member with its own steps; a step that would take
+// a bond too close to d_max is taken again with half the step (solvers/batch_stepper.hpp).
+void run_members(std::vector<Member>& ms, bool quiet, int threads) {
+  std::signal(SIGINT, on_signal);  // from the start: a stop during the set-up ends after the first step
+  std::signal(SIGTERM, on_signal);
+  for (Member& m : ms) prepare_member(m);
+  for (std::size_t k = 1; k < ms.size(); ++k) {
+    const std::string why = batch_difference(ms[0], ms[k]);
+    if (!why.empty())
+      throw SceneError("--batch: member " + std::to_string(k + 1) + " (" + ms[k].options.out_dir +
+                       ") cannot share the batch: " + why);
+  }
+  if (ms.front().so.check) {  // everything above would have stopped a bad run; nothing is written
+    for (const Member& m : ms)
+      std::printf("spread: scene %s: ok (checked, nothing written)\n", m.scene.name().c_str());
+    return;
+  }
+  for (Member& m : ms) {
+    m.out_dir = m.restart ? std::filesystem::path(m.so.restart).parent_path().lexically_normal().string()
+                          : prepare_output_dir(m.options, m.scene);
+    if (m.out_dir.empty()) m.out_dir = ".";
+    m.checkpoint_path = m.out_dir + "/checkpoint.h5";
+    m.csv_tmp = m.out_dir + "/series.csv.part";
+  }
+  KokkosSession kokkos(threads);
+  const auto wall0 = std::chrono::steady_clock::now();
+
+  std::vector<HostCell> cells;
+  std::vector<MechanicsParams> params;
+  int first = 0;
+  for (std::size_t k = 0; k < ms.size(); ++k) {
+    Member& m = ms[k];
+    cells.emplace_back(m.mesh);
+    params.push_back(m.params);
+    m.cell = static_cast<int>(k);
+    m.first_node = first;
+    m.n = static_cast<int>(m.mesh.nodes.size());
+    first += m.n;
+  }
+  Model model(Exec(), cells, params);
+  NodeFields<Exec::memory_space> fields(model.mesh().n_nodes);
+  Stepper stepper(model, ms.front().steps);
+  for (Member& m : ms) {
+    if (m.restart) {  // a restart is a one-member run
+      const Checkpoint& c = *m.restart;
+      model.restore_state(c);
+      stepper.restore_state(c);
+      const auto progress = m.p.fields();
+      const std::vector<double>& saved = c.array("app.progress", progress.size());
+      for (std::size_t i = 0; i < progress.size(); ++i) *progress[i] = saved[i];
+      m.ts = c.array("app.t_s");
+      m.rs = c.array("app.r_cc_m", m.ts.size());
+      m.areas_c = c.array("app.contact_area_m2", m.ts.size());
+      m.heights = c.array("app.height_m", m.ts.size());
+      m.csv_text = c.text("app.series_csv");
+      m.frames_before = static_cast<int>(c.scalar("app.frames"));
+    }
+    std::vector<int> tri, node_cell(m.n, 0);
+    for (const Tri& t : m.mesh.triangles) tri.insert(tri.end(), t.begin(), t.end());
+    if (m.restart) {
+      m.h5 = std::make_unique<H5Output>(m.out_dir + "/spread.h5", H5Output::Resume{m.frames_before});
+    } else {
+      m.h5 = std::make_unique<H5Output>(m.out_dir + "/spread.h5");
+      m.h5->write_text("scene", m.scene.to_toml());
+      m.h5->write_mesh(model.cell_slice(model.positions(), m.cell).data(), m.n, tri.data(),
+                       static_cast<int>(m.mesh.triangles.size()), node_cell.data());
+    }
+    for (std::size_t i = 0; i < m.ts.size(); ++i)
+      m.h5->append_series({{"t_s", m.ts[i]},
+                           {"r_cc_m", m.rs[i]},
+                           {"contact_area_m2", m.areas_c[i]},
+                           {"height_m", m.heights[i]}});
+    m.csv.open(m.csv_tmp, std::ios::trunc);
+    m.csv << m.csv_text;
+    if (!m.csv) throw IoError(m.csv_tmp + ": cannot write");
+    m.steps_before = static_cast<long long>(m.p.step);
+    m.last = stepper.time(m.cell) >= m.t_end * (1 - 1e-12);
+    m.last_checkpoint = std::chrono::steady_clock::now();
+    if (quiet) continue;
+    if (m.restart)
+      std::printf(
+          "dcm spread: restart from %s at t = %.6g s (step %lld), scene '%s', %d nodes, t_end = %.3g s; %s\n",
+          m.so.restart.c_str(), stepper.time(m.cell), static_cast<long long>(m.p.step),
+          m.scene.name().c_str(), m.n, m.t_end, kokkos_description().c_str());
+    else if (ms.size() == 1)
+      std::printf("dcm spread: scene '%s', %d nodes, dt = %.3g s, t_end = %.3g s (%lld steps); %s\n",
+                  m.scene.name().c_str(), m.n, m.dt, m.t_end, std::llround(m.t_end / m.dt),
+                  kokkos_description().c_str());
+  }
+  if (!quiet && ms.size() > 1)
+    std::printf("dcm spread: a batch of %zu members (%d nodes each) in one model; %s\n", ms.size(), ms[0].n,
+                kokkos_description().c_str());
+
+  auto last_progress = std::chrono::steady_clock::now();
+  const std::size_t n_members = ms.size();
+  std::vector<double> cap(n_members), e0, pc, dis, e1, area_cells, load_cells;
+  long long batch_steps = 0;
+  for (;;) {
+    bool any_running = false;
+    for (Member& m : ms) {
+      cap[m.cell] = 0;
+      if (m.last || m.done) continue;
+      any_running = true;
+      m.t = stepper.time(m.cell);
+      m.index = static_cast<long long>(m.p.step);
+      // The last step lands on t_end (a fixed-step run's last step may be up to 1.5 Δt long, as before).
+      const double remaining = m.t_end - m.t;
+      m.h_cap = m.steps.adaptive ? remaining : (remaining < 1.5 * m.dt ? remaining : INFINITY);
+      cap[m.cell] = m.h_cap;
+    }
+    if (!any_running) break;
+    std::vector<StepReport> rep;
+    try {
+      rep = stepper.step(model, ms.front().cg, cap, [&](const std::vector<double>& h_planned) {
+        bool any_sample = false;
+        for (Member& m : ms) {
+          m.sample = false;
+          if (cap[m.cell] == 0) continue;
+          const double t = m.t;
+          Progress& p = m.p;
+          const auto next_figure = static_cast<std::size_t>(p.next_figure);
+          if (t >= p.next_frame - 1e-12 ||
+              (next_figure < kFigureTimes.size() && t >= kFigureTimes[next_figure] - 1e-12)) {
+            write_frame(m, model, fields, t);
+            while (p.next_frame <= t + 1e-12) p.next_frame += m.frame_every;
+            std::size_t f = next_figure;
+            while (f < kFigureTimes.size() && kFigureTimes[f] <= t + 1e-12) ++f;
+            p.next_figure = static_cast<double>(f);
+          }
+          m.sample = t >= p.next_sample || m.index < 10 || h_planned[m.cell] >= m.h_cap;
+          any_sample = any_sample || m.sample;
+        }
+        if (any_sample) {  // each cell's own sums (solvers/cortex_model.hpp): the bits of its run alone
+          model.energy(&e0);
+          model.contact_power(&pc);
+          model.dissipation(&dis);
+          for (Member& m : ms)
+            if (m.sample) {
+              m.e0 = e0[m.cell];
+              m.pc = pc[m.cell];
+              m.dis = dis[m.cell];
+            }
+        }
+      });
+    } catch (const NumericalError& e) {
+      const Member& m = ms.front();
+      stop_on_numerical_trouble(ms, (ms.size() == 1 ? "step " + std::to_string(m.index) +
+                                                          " (t = " + std::to_string(stepper.time(0)) + " s): "
+                                                    : "batch step " + std::to_string(batch_steps) + ": ") +
+                                        e.what());
+    }
+    ++batch_steps;
+    bool any_row = false;
+    for (Member& m : ms) any_row = any_row || (cap[m.cell] > 0 && m.sample);
+    if (any_row) {  // after the step: each sampled member's row
+      model.energy(&e1);
+      model.contact_area(&area_cells);
+      model.contact_load(&load_cells);
+    }
+    const std::vector<double> cell_area =
+        any_row ? to_host_vector(model.geometry().cell_area) : std::vector<double>();
+    const std::vector<double> cell_volume =
+        any_row ? to_host_vector(model.geometry().cell_volume) : std::vector<double>();
+    for (Member& m : ms) {
+      if (cap[m.cell] == 0) continue;
+      const StepReport& r = rep[m.cell];
+      Progress& p = m.p;
+      p.step += 1;
+      const double h = r.h, t = m.t;
+      m.last = stepper.time(m.cell) >= m.t_end * (1 - 1e-12);
+      p.cg_total += r.iterations;
+      p.cg_max = std::max(p.cg_max, static_cast<double>(r.iterations));
+      p.halved += r.halvings;
+      p.rejected += r.rejections;
+      p.h_min = std::min(p.h_min, h);
+      p.h_max = std::max(p.h_max, h);
+      if (m.sample) {
+        // Energy balance of the step: (E(t+h) − E(t))/h against the contact power minus the dissipation.
+        const double e_after = e1[m.cell], de = (e_after - m.e0) / h, residual = de - (m.pc - m.dis);
+        p.worst_residual = std::max(p.worst_residual, std::fabs(residual));
+        p.worst_residual_scale = std::max(p.worst_residual_scale, std::fabs(m.dis) + std::fabs(m.pc));
+        const double area_c = area_cells[m.cell];
+        if (!(area_c >= 0)) {  // not finite: the state is no longer a cell
+          const auto tri_area_c = to_host_vector(model.contact()->tri_contact_area);
+          const int t0 = model.mesh().host_cell_tri_begin[m.cell],
+                    t1 = model.mesh().host_cell_tri_begin[m.cell + 1];
+          int bad = t0;
+          while (bad < t1 && tri_area_c[bad] >= 0) ++bad;
+          stop_on_numerical_trouble(ms, "step " + std::to_string(m.index) + " (t = " + std::to_string(t + h) +
+                                            " s): the contact area is " + detail::format_real(area_c) +
+                                            " m² (first at triangle " + std::to_string(bad - t0) + ")" +
+                                            (ms.size() > 1 ? " of member " + m.out_dir : std::string()));
+        }
+        const double r_cc = std::sqrt(area_c / kPi);
+        const auto xh = model.cell_slice(model.positions(), m.cell);
+        double ztop = -INFINITY;
+        for (int i = 0; i < m.n; ++i) ztop = std::max(ztop, xh[3 * i + 2]);
+        char line[512];
+        std::snprintf(line, sizeof line,
+                      "%.9g,%.9g,%.9g,%.9g,%.9g,%d,%.6g,%.9g,%.9g,%.12g,%.6g,%.6g,%.6g,%.6g\n", t + h, r_cc,
+                      area_c, cell_area[m.cell], cell_volume[m.cell], r.iterations, h, ztop - m.plane_z,
+                      load_cells[m.cell], e_after, de, m.pc, m.dis, residual);
+        m.csv << line;
+        m.csv_text += line;
+        m.ts.push_back(t + h);
+        m.rs.push_back(r_cc);
+        m.areas_c.push_back(area_c);
+        m.heights.push_back(ztop - m.plane_z);
+        m.h5->append_series(
+            {{"t_s", t + h}, {"r_cc_m", r_cc}, {"contact_area_m2", area_c}, {"height_m", ztop - m.plane_z}});
+        p.next_sample = (t + h) * std::pow(10.0, 1.0 / m.per_decade);
+      }
+      m.stopped_at_max_steps = m.so.max_steps > 0 && p.step >= static_cast<double>(m.so.max_steps) && !m.last;
+    }
+    // Progress every 2 s of wall time, independent of the (log-spaced) series rows.
+    if (!quiet && seconds_since(last_progress) > 2.0) {
+      const double wall = seconds_since(wall0);
+      if (ms.size() == 1) {
+        const Member& m = ms.front();
+        const double h = rep[0].h, rate = (m.p.step - m.steps_before) / wall;
+        std::printf("  t = %.4f s  r_cc = %.3f um  dt = %.2g s  CG %d it  %.0f steps/s  ETA %.0f s\n",
+                    stepper.time(0), std::sqrt(model.contact_area() / kPi) * 1e6, h, rep[0].iterations, rate,
+                    (m.t_end - stepper.time(0)) / h / rate);
+      } else {
+        int running = 0;
+        double slowest = 1;
+        for (const Member& m : ms)
+          if (!m.last && !m.done) {
+            ++running;
+            slowest = std::min(slowest, stepper.time(m.cell) / m.t_end);
+          }
+        std::printf(
+            "  batch step %lld: %d of %zu members running, the slowest at %.1f%% of its t_end, %.0f "
+            "batch steps/s\n",
+            batch_steps, running, ms.size(), 100 * slowest, batch_steps / wall);
+      }
+      std::fflush(stdout);
+      last_progress = std::chrono::steady_clock::now();
+    }
+    bool stop_all = false;
+    for (Member& m : ms)
+      if (!m.done && m.stopped_at_max_steps) stop_all = true;
+    if (g_stop || stop_all) {
+      for (Member& m : ms)
+        if (!m.done) m.interrupted = g_stop && !m.last;
+      break;
+    }
+    for (Member& m : ms)
+      if (!m.done && !m.last && m.checkpoint_every > 0 &&
+          seconds_since(m.last_checkpoint) > m.checkpoint_every) {
+        write_checkpoint_now(m, model, stepper, seconds_since(wall0));
+        m.last_checkpoint = std::chrono::steady_clock::now();
+      }
+    // Members that reached their t_end: final state written (their cell no longer steps).
+    for (Member& m : ms)
+      if (!m.done && m.last) finish_member(m, model, stepper, fields, seconds_since(wall0));
+  }
+  // The final state of the members still open (interrupted or stopped at --max-steps).
+  for (Member& m : ms)
+    if (!m.done) finish_member(m, model, stepper, fields, seconds_since(wall0));
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  for (const Member& m : ms)
+    if (m.interrupted)
+      throw AppInterrupted(
+          "interrupted at t = " + std::to_string(stepper.time(m.cell)) + " s; " + m.out_dir +
+          "/spread.h5, series.csv and summary.json hold what was done; continue with: spread "
+          "--restart " +
+          m.checkpoint_path);
+}
+
+// Splits a member line into words; "double quotes" keep spaces.
+std::vector<std::string> split_words(const std::string& line) {
+  std::vector<std::string> words;
+  std::string w;
+  bool quoted = false, have = false;
+  for (const char ch : line) {
+    if (ch == '"') {
+      quoted = !quoted;
+      have = true;
+    } else if (!quoted && (ch == ' ' || ch == '\t')) {
+      if (have) words.push_back(w);
+      w.clear();
+      have = false;
+    } else {
+      w += ch;
+      have = true;
+    }
+  }
+  if (quoted) throw SceneError("an unclosed \" in: " + line);
+  if (have) words.push_back(w);
+  return words;
+}
+
+// The members of --batch FILE: one per line, `[SCENE.toml] [--set KEY=VALUE]... --out DIR`; # comments.
+std::vector<Member> read_batch(const std::string& path, const AppOptions& common, const SpreadOptions& so) {
+  std::ifstream in(path);
+  if (!in) throw IoError(path + ": cannot read the batch file");
+  std::vector<Member> ms;
+  std::string line;
+  int number = 0;
+  std::vector<std::string> outs;
+  while (std::getline(in, line)) {
+    ++number;
+    const std::string where = path + ":" + std::to_string(number) + ": ";
+    const std::vector<std::string> words = split_words(line.substr(0, line.find('#')));
+    if (words.empty()) continue;
+    Member& m = ms.emplace_back();
+    m.options.quiet = common.quiet;
+    m.options.threads = common.threads;
+    m.so = so;
+    for (std::size_t k = 0; k < words.size(); ++k) {
+      const std::string& w = words[k];
+      if ((w == "--set" || w == "--out") && k + 1 < words.size()) {
+        (w == "--set" ? m.options.sets.push_back(words[k + 1]) : void(m.options.out_dir = words[k + 1]));
+        ++k;
+      } else if (w.rfind("--", 0) != 0 && k == 0) {
+        if (!std::filesystem::exists(w)) throw SceneError(where + "scene file " + w + " does not exist");
+        m.options.scene_path = w;
+      } else {
+        throw SceneError(where + "'" + w +
+                         "' is not allowed: a member line is [SCENE.toml] [--set KEY=VALUE]... --out DIR");
+      }
+    }
+    if (m.options.out_dir.empty()) throw SceneError(where + "a member needs --out DIR (its own folder)");
+    for (const std::string& o : outs)
+      if (o == m.options.out_dir)
+        throw SceneError(where + "--out " + o + " is already another member's folder");
+    outs.push_back(m.options.out_dir);
+  }
+  if (ms.empty()) throw SceneError(path + ": no member in the batch file");
+  return ms;
+}
+
+void run(const AppOptions& options, const SpreadOptions& so) {
+  if (!so.batch.empty()) {
+    if (!so.restart.empty())
+      throw SceneError("--batch with --restart: a restart continues one run; restart the member alone");
+    if (!options.scene_path.empty() || !options.sets.empty() || !options.out_dir.empty())
+      throw SceneError("--batch: give the scene, --set and --out of each member in the batch file, not here");
+    std::vector<Member> ms = read_batch(so.batch, options, so);
+    run_members(ms, options.quiet, options.threads);
+    return;
+  }
+  std::vector<Member> ms(1);
+  ms[0].options = options;
+  ms[0].so = so;
+  run_members(ms, options.quiet, options.threads);
 }
 
 }  // namespace
 }  // namespace dcm
-
 int main(int argc, char** argv) {
   CLI::App app(
       "Cell spreading on an adhesive plane (the paper's Figures 1, 4-6). Without a scene file it runs the\n"
@@ -515,6 +775,12 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1LL, 1000000000000LL));
   app.add_flag("--check", so.check,
                "Only check the scene and the options (exit 0, or 2 with the error); write and run nothing");
+  app.add_option(
+         "--batch", so.batch,
+         "Run the members listed in this file as one batch (one model, one launch per kernel for all; "
+         "docs/SCANS.md): one member per line, [SCENE.toml] [--set KEY=VALUE]... --out DIR. Each "
+         "member's folder gets what its run alone writes, with the same numbers")
+      ->check(CLI::ExistingFile);
   return dcm::run_app(app, argc, argv, [&] {
     if (window.size() == 2) {
       so.early_from_s = window[0];
