@@ -45,6 +45,16 @@ KOKKOS_INLINE_FUNCTION T cell_value(const PerCell<T, MemorySpace>& table, int c)
   return table.values(c);
 }
 
+// Which cells a kernel works on: one flag per cell; an empty View means every cell. A batch's CG skips the
+// cells that have converged or are not stepping (the operators are block-diagonal per cell, so no other
+// cell reads their rows).
+template <class MemorySpace>
+using CellFlags = Kokkos::View<int*, Kokkos::LayoutRight, MemorySpace>;
+template <class Flags>
+KOKKOS_INLINE_FUNCTION bool skipped(const Flags& active, int cell) {
+  return active.extent(0) > 0 && active(cell) == 0;
+}
+
 // Whether a constant is non-zero for some cell (a term with a zero constant everywhere is skipped).
 inline bool any_nonzero(double k) { return k != 0; }
 template <class MemorySpace>

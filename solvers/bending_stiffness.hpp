@@ -47,8 +47,10 @@ template <class ExecutionSpace, class MemorySpace>
 void apply_bending_stiffness(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                              const HingeRest<MemorySpace>& hinges, const BendingStiffness<MemorySpace>& bs,
                              const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& v,
-                             const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& out) {
+                             const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& out,
+                             const CellFlags<MemorySpace>& active = {}) {
   const auto hinge = mesh.hinge;
+  const auto node_cell = mesh.node_cell;
   const auto g = hinges.hinge_grad;
   const auto cos_delta = hinges.hinge_cos_delta;
   const auto s = bs.s;
@@ -57,6 +59,7 @@ void apply_bending_stiffness(const ExecutionSpace& space, const MeshBuffers<Memo
   Kokkos::parallel_for(
       "dcm::bending_stiffness::project", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_hinges),
       KOKKOS_LAMBDA(const int h) {
+        if (skipped(active, hinge_cell(h))) return;
         double sum = 0;
         for (int a = 0; a < 4; ++a) {
           const int i = hinge(h, a);
@@ -69,6 +72,7 @@ void apply_bending_stiffness(const ExecutionSpace& space, const MeshBuffers<Memo
   Kokkos::parallel_for(
       "dcm::bending_stiffness::gather", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
+        if (skipped(active, node_cell(i))) return;
         double o0 = 0, o1 = 0, o2 = 0;
         for (int k = offsets(i); k < offsets(i + 1); ++k) {
           const int h = roles(k) / 4, a = roles(k) % 4;

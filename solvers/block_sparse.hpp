@@ -19,6 +19,7 @@ struct BlockCsr {
   View<int*> diag_slot;    // n_rows: the slot of (i, i)
   View<double* [6]> values;
   View<double* [6]> diag_inverse;  // inverse of each diagonal block, for the smoother
+  View<int*> row_cell;             // the cell of each row (the blocks never couple two cells)
 };
 
 KOKKOS_INLINE_FUNCTION Real3 sym3_times(const double a0, const double a1, const double a2, const double a3,
@@ -27,15 +28,18 @@ KOKKOS_INLINE_FUNCTION Real3 sym3_times(const double a0, const double a1, const 
 }
 
 // out = b − A x, the residual; one gather per row.
+// active (optional): only the rows of these cells (core/cell_params.hpp; needs row_cell).
 template <class ExecutionSpace, class MemorySpace, class Vector>
 void block_csr_residual(const ExecutionSpace& space, const BlockCsr<MemorySpace>& a, const Vector& b,
-                        const Vector& x, const Vector& out) {
+                        const Vector& x, const Vector& out, const CellFlags<MemorySpace>& active = {}) {
+  const auto row_cell = a.row_cell;
   const auto off = a.row_offsets;
   const auto cols = a.cols;
   const auto val = a.values;
   Kokkos::parallel_for(
       "dcm::bsr::residual", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows),
       KOKKOS_LAMBDA(const int i) {
+        if (skipped(active, row_cell(i))) return;
         Real3 acc = load3(b, i);
         for (int s = off(i); s < off(i + 1); ++s) {
           const Real3 y =
@@ -66,11 +70,14 @@ void block_csr_invert_diagonal(const ExecutionSpace& space, const BlockCsr<Memor
 // x = (accumulate ? x : 0) + ω D⁻¹ r: one damped block-Jacobi step given the residual r.
 template <class ExecutionSpace, class MemorySpace, class Vector>
 void block_jacobi_step(const ExecutionSpace& space, const BlockCsr<MemorySpace>& a, double omega,
-                       bool accumulate, const Vector& r, const Vector& x) {
+                       bool accumulate, const Vector& r, const Vector& x,
+                       const CellFlags<MemorySpace>& active = {}) {
   const auto inv = a.diag_inverse;
+  const auto row_cell = a.row_cell;
   Kokkos::parallel_for(
       "dcm::bsr::jacobi_step", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows),
       KOKKOS_LAMBDA(const int i) {
+        if (skipped(active, row_cell(i))) return;
         const Real3 dz =
             omega * sym3_times(inv(i, 0), inv(i, 1), inv(i, 2), inv(i, 3), inv(i, 4), inv(i, 5), load3(r, i));
         store3(x, i, accumulate ? load3(x, i) + dz : dz);

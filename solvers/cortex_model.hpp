@@ -413,16 +413,18 @@ class CortexModel {
     }
     const CgResult r = pcg_solve(
         space_,
+        // Only the cells still iterating (a batch: the others have converged or are not stepping).
         [&](const Vector& in, const Vector& out) {
-          apply_friction(space_, mesh_, friction_, in, out);
-          if (implicit) apply_global_stiffness(space_, mesh_, *global_, in, out);
+          apply_friction(space_, mesh_, friction_, in, out, cg_.active);
+          if (implicit) apply_global_stiffness(space_, mesh_, *global_, in, out, cg_.active);
           if (implicit_bending)
-            apply_bending_stiffness(space_, mesh_, *hinges_, *bending_stiffness_, in, out);
-          if (implicit_tension) apply_tension_stiffness(space_, mesh_, *tension_stiffness_, in, out);
+            apply_bending_stiffness(space_, mesh_, *hinges_, *bending_stiffness_, in, out, cg_.active);
+          if (implicit_tension)
+            apply_tension_stiffness(space_, mesh_, *tension_stiffness_, in, out, cg_.active);
         },
         [&](const Vector& in, const Vector& out) {
           if (multigrid_)
-            apply_multigrid(space_, *multigrid_, in, out);
+            apply_multigrid(space_, *multigrid_, in, out, cg_.active);
           else
             apply_block_jacobi(space_, friction_, in, out);
         },

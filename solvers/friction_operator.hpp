@@ -263,11 +263,13 @@ void update_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>
 }
 
 // out = Γ v (eq. 32's right-hand side operator).
+// active (optional): only the rows of these cells (core/cell_params.hpp).
 template <class ExecutionSpace, class MemorySpace>
 void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                     const FrictionOperator<MemorySpace>& op,
                     const typename FrictionOperator<MemorySpace>::Vector& v,
-                    const typename FrictionOperator<MemorySpace>::Vector& out) {
+                    const typename FrictionOperator<MemorySpace>::Vector& out,
+                    const CellFlags<MemorySpace>& active = {}) {
   const auto bond = mesh.bond;
   const auto offsets = mesh.node_bond_offsets;
   const auto bonds = mesh.node_bonds;
@@ -291,6 +293,7 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
     Kokkos::parallel_for(
         "dcm::friction::substrate_triangles", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_tris),
         KOKKOS_LAMBDA(const int t) {
+          if (skipped(active, tri_cell(t))) return;
           const double area = contact_area(t);
           Real3 u{0, 0, 0};
           if (area > 0) {
@@ -305,6 +308,7 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
       "dcm::friction::apply", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
         const int cell = node_cell(i);
+        if (skipped(active, cell)) return;
         const double c = coef(cell, kDashpot), c_t = coef(cell, kDashpotTransverse);
         const Real3 vi = load3(v, i);
         Real3 acc = drag(i) * vi;

@@ -80,24 +80,27 @@ template <class ExecutionSpace, class MemorySpace>
 void apply_global_stiffness(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                             const GlobalStiffness<MemorySpace>& g,
                             const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& v,
-                            const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& out) {
+                            const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& out,
+                            const CellFlags<MemorySpace>& active = {}) {
   const auto grad_area = g.grad_area, grad_volume = g.grad_volume;
   const bool with_area = g.area, with_volume = g.volume;
+  const auto node_cell = mesh.node_cell;
   segmented_sum<2>(
       "dcm::global::dots", space, mesh.node_sums,
       KOKKOS_LAMBDA(const int i, double(&s)[2]) {
+        if (skipped(active, node_cell(i))) return;
         const Real3 vi = load3(v, i);
         if (with_area) s[0] += dot(load3(grad_area, i), vi);
         if (with_volume) s[1] += dot(load3(grad_volume, i), vi);
       },
       PairOut<MemorySpace>{g.dot_area, g.dot_volume});
-  const auto node_cell = mesh.node_cell;
   const auto coef_area = g.coef_area, coef_volume = g.coef_volume, dot_area = g.dot_area,
              dot_volume = g.dot_volume;
   Kokkos::parallel_for(
       "dcm::global::apply", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
         const int c = node_cell(i);
+        if (skipped(active, c)) return;
         Real3 add{0, 0, 0};
         if (with_area) add += (coef_area(c) * dot_area(c)) * load3(grad_area, i);
         if (with_volume) add += (coef_volume(c) * dot_volume(c)) * load3(grad_volume, i);

@@ -150,10 +150,12 @@ Multigrid<MemorySpace> make_multigrid(const std::vector<HostCell>& cells,
   mg.fine_slot_bond = mg_detail::upload_vector<IV>("fine_slot_bond", h.fine_slot_bond);
   const int n_levels = h.available ? static_cast<int>(h.transfers.size()) + 1 : 1;
   mg.levels.resize(n_levels);
+  std::vector<int> row_cell = to_host_vector(mesh.node_cell);  // of the level being built
   for (int l = 0; l < n_levels; ++l) {
     MultigridLevel<MemorySpace>& lv = mg.levels[l];
     lv.a = mg_detail::allocate_blocks<MemorySpace>(l == 0 ? h.fine : h.transfers[l - 1].coarse);
     const int n = lv.a.n_rows;
+    lv.a.row_cell = mg_detail::upload_vector<IV>("row_cell", row_cell);
     lv.r = typename MultigridLevel<MemorySpace>::template View<double* [3]>("dcm::mg::r", n);
     if (l > 0) {
       lv.b = typename MultigridLevel<MemorySpace>::template View<double* [3]>("dcm::mg::b", n);
@@ -176,6 +178,9 @@ Multigrid<MemorySpace> make_multigrid(const std::vector<HostCell>& cells,
       lv.restrict_offsets = mg_detail::upload_vector<IV>("restrict_offsets", t.restrict_offsets);
       lv.restrict_fine = mg_detail::upload_vector<IV>("restrict_fine", t.restrict_fine);
       lv.restrict_weight = mg_detail::upload_vector<DV>("restrict_weight", t.restrict_weight);
+      std::vector<int> coarse_cell(h.transfers[l].coarse.rows(), 0);  // a coarse node's fine children's cell
+      for (int i = 0; i < n; ++i) coarse_cell[t.prolong[i][0]] = coarse_cell[t.prolong[i][1]] = row_cell[i];
+      row_cell = coarse_cell;
     }
   }
   {  // the triangle corners of each fine slot, for the implicit tension blocks
@@ -314,13 +319,14 @@ namespace mg_detail {
 
 template <class ExecutionSpace, class MemorySpace, class Vector>
 void coarse_solve(const ExecutionSpace& space, const Multigrid<MemorySpace>& mg, const Vector& b,
-                  const Vector& x) {
+                  const Vector& x, const CellFlags<MemorySpace>& active) {
   constexpr int n = Multigrid<MemorySpace>::kCoarseDofs, nodes = Multigrid<MemorySpace>::kCoarseNodes;
   const auto inv = mg.coarse_inverse;
   Kokkos::parallel_for(
       "dcm::mg::coarse_solve", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mg.n_cells * n),
       KOKKOS_LAMBDA(const int q) {
         const int c = q / n, p = q % n;
+        if (skipped(active, c)) return;
         double s = 0;
         for (int k = 0; k < n; ++k) s += inv(c, p, k) * b(c * nodes + k / 3, k % 3);
         x(c * nodes + p / 3, p % 3) = s;
@@ -328,14 +334,17 @@ void coarse_solve(const ExecutionSpace& space, const Multigrid<MemorySpace>& mg,
 }
 
 template <class ExecutionSpace, class MemorySpace, class Vector>
-void restrict_residual(const ExecutionSpace& space, const MultigridLevel<MemorySpace>& fine, const Vector& r,
-                       const Vector& out) {
+void restrict_residual(const ExecutionSpace& space, const MultigridLevel<MemorySpace>& fine,
+                       const MultigridLevel<MemorySpace>& coarse, const Vector& r, const Vector& out,
+                       const CellFlags<MemorySpace>& active) {
+  const auto row_cell = coarse.a.row_cell;
   const auto off = fine.restrict_offsets;
   const auto idx = fine.restrict_fine;
   const auto w = fine.restrict_weight;
   Kokkos::parallel_for(
       "dcm::mg::restrict", Kokkos::RangePolicy<ExecutionSpace>(space, 0, out.extent(0)),
       KOKKOS_LAMBDA(const int I) {
+        if (skipped(active, row_cell(I))) return;
         Real3 acc{0, 0, 0};
         for (int q = off(I); q < off(I + 1); ++q) acc += w(q) * load3(r, idx(q));
         store3(out, I, acc);
@@ -344,51 +353,54 @@ void restrict_residual(const ExecutionSpace& space, const MultigridLevel<MemoryS
 
 template <class ExecutionSpace, class MemorySpace, class Vector>
 void prolong_add(const ExecutionSpace& space, const MultigridLevel<MemorySpace>& fine, const Vector& coarse,
-                 const Vector& x) {
+                 const Vector& x, const CellFlags<MemorySpace>& active) {
   const auto p = fine.prolong;
+  const auto row_cell = fine.a.row_cell;
   Kokkos::parallel_for(
       "dcm::mg::prolong", Kokkos::RangePolicy<ExecutionSpace>(space, 0, x.extent(0)),
       KOKKOS_LAMBDA(const int i) {
+        if (skipped(active, row_cell(i))) return;
         store3(x, i, load3(x, i) + 0.5 * (load3(coarse, p(i, 0)) + load3(coarse, p(i, 1))));
       });
 }
 
 template <class ExecutionSpace, class MemorySpace, class Vector>
 void vcycle(const ExecutionSpace& space, const Multigrid<MemorySpace>& mg, std::size_t l, const Vector& b,
-            const Vector& x) {
+            const Vector& x, const CellFlags<MemorySpace>& active) {
   const MultigridLevel<MemorySpace>& lv = mg.levels[l];
   if (l + 1 == mg.levels.size()) {
-    coarse_solve(space, mg, b, x);
+    coarse_solve(space, mg, b, x, active);
     return;
   }
   const double omega = mg.settings.damping;
-  block_jacobi_step(space, lv.a, omega, false, b, x);  // first sweep from x = 0
+  block_jacobi_step(space, lv.a, omega, false, b, x, active);  // first sweep from x = 0
   for (int s = 1; s < mg.settings.sweeps; ++s) {
-    block_csr_residual(space, lv.a, b, x, lv.r);
-    block_jacobi_step(space, lv.a, omega, true, lv.r, x);
+    block_csr_residual(space, lv.a, b, x, lv.r, active);
+    block_jacobi_step(space, lv.a, omega, true, lv.r, x, active);
   }
-  block_csr_residual(space, lv.a, b, x, lv.r);
+  block_csr_residual(space, lv.a, b, x, lv.r, active);
   const MultigridLevel<MemorySpace>& next = mg.levels[l + 1];
-  restrict_residual(space, lv, lv.r, next.b);
-  vcycle(space, mg, l + 1, next.b, next.x);
-  prolong_add(space, lv, next.x, x);
+  restrict_residual(space, lv, next, lv.r, next.b, active);
+  vcycle(space, mg, l + 1, next.b, next.x, active);
+  prolong_add(space, lv, next.x, x, active);
   for (int s = 0; s < mg.settings.sweeps; ++s) {
-    block_csr_residual(space, lv.a, b, x, lv.r);
-    block_jacobi_step(space, lv.a, omega, true, lv.r, x);
+    block_csr_residual(space, lv.a, b, x, lv.r, active);
+    block_jacobi_step(space, lv.a, omega, true, lv.r, x, active);
   }
 }
 
 }  // namespace mg_detail
 
 // z = M⁻¹ r: one V-cycle from z = 0 (block-Jacobi when the mesh has no hierarchy).
+// active (optional): only the rows of these cells (core/cell_params.hpp).
 template <class ExecutionSpace, class MemorySpace, class Vector>
 void apply_multigrid(const ExecutionSpace& space, const Multigrid<MemorySpace>& mg, const Vector& r,
-                     const Vector& z) {
+                     const Vector& z, const CellFlags<MemorySpace>& active = {}) {
   if (!mg.available) {
-    block_jacobi_step(space, mg.levels[0].a, 1.0, false, r, z);
+    block_jacobi_step(space, mg.levels[0].a, 1.0, false, r, z, active);
     return;
   }
-  mg_detail::vcycle(space, mg, 0, r, z);
+  mg_detail::vcycle(space, mg, 0, r, z, active);
 }
 
 }  // namespace dcm

@@ -40,6 +40,10 @@ struct CgWorkspace {
   Kokkos::View<int*, Kokkos::LayoutRight, MemorySpace> node_segment;
   Scalars alpha, beta;  // per segment; 0 freezes a segment
   typename Scalars::HostMirror alpha_host, beta_host;
+  // 1 for the segments still iterating, kept up to date during a solve: an operator or preconditioner may
+  // skip the rows of the others (their results are not used).
+  Kokkos::View<int*, Kokkos::LayoutRight, MemorySpace> active;
+  typename Kokkos::View<int*, Kokkos::LayoutRight, MemorySpace>::HostMirror active_host;
   std::vector<CgResult> segment_results;  // of the last solve, one per segment
 
   CgWorkspace() = default;
@@ -56,6 +60,8 @@ struct CgWorkspace {
         beta("dcm::cg::beta", segment_begin.size() - 1),
         alpha_host(Kokkos::create_mirror_view(alpha)),
         beta_host(Kokkos::create_mirror_view(beta)),
+        active("dcm::cg::active", segment_begin.size() - 1),
+        active_host(Kokkos::create_mirror_view(active)),
         segment_results(segment_begin.size() - 1) {
     auto h = Kokkos::create_mirror_view(node_segment);
     for (std::size_t s = 0; s + 1 < segment_begin.size(); ++s)
@@ -105,7 +111,7 @@ inline CgResult combine(const std::vector<CgResult>& seg) {
   for (std::size_t s = 0; s < seg.size(); ++s) {
     all.iterations = seg[s].iterations > all.iterations ? seg[s].iterations : all.iterations;
     if (!seg[s].converged && worst < 0) worst = static_cast<int>(s);
-    if (!(seg[s].residual_norm < INFINITY)) {
+    if (!seg[s].converged && !(seg[s].residual_norm < INFINITY)) {
       worst = static_cast<int>(s);
       break;
     }
@@ -137,6 +143,12 @@ CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& pr
   std::vector<double> bb(n_seg), rr(n_seg), rz(n_seg), pq(n_seg), rz_new(n_seg), tol(n_seg);
   std::vector<char> active(n_seg, 0);
   int n_active = 0;
+  const auto publish = [&] {  // w.active = the segments still iterating
+    for (int s = 0; s < n_seg; ++s) w.active_host(s) = active[s];
+    Kokkos::deep_copy(space, w.active, w.active_host);
+  };
+  for (int s = 0; s < n_seg; ++s) active[s] = frozen && (*frozen)[s] ? 0 : 1;
+  publish();
 
   cg_detail::segment_dots(space, sums, b, b, bb);
   apply(x, q);  // r = b - Γ x
@@ -151,17 +163,22 @@ CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& pr
       sums.result);
   Kokkos::deep_copy(space, sums.result_host, sums.result);
   space.fence();
+  n_active = 0;
   for (int s = 0; s < n_seg; ++s) {
     res[s] = CgResult{};
     res[s].rhs_norm = math::sqrt(bb[s]);
     tol[s] = math::max(settings.abs_tol, settings.rel_tol * res[s].rhs_norm);
     res[s].residual_norm = math::sqrt(sums.result_host(s, 0));
     res[s].converged = res[s].residual_norm <= tol[s];
-    if (frozen && (*frozen)[s]) res[s].converged = true;
+    if (frozen && (*frozen)[s]) {  // not solved: its rows were skipped
+      res[s].residual_norm = 0;
+      res[s].converged = true;
+    }
     active[s] = res[s].converged ? 0 : 1;
     n_active += active[s];
   }
   if (n_active == 0) return cg_detail::combine(res);
+  publish();
   precondition(r, z);
   Kokkos::deep_copy(space, p, z);
   cg_detail::segment_dots(space, sums, r, z, rz);
@@ -184,6 +201,7 @@ CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& pr
         sums.result);
     Kokkos::deep_copy(space, sums.result_host, sums.result);
     space.fence();
+    bool stopped = false;
     for (int s = 0; s < n_seg; ++s) {
       if (!active[s]) continue;
       res[s].iterations = it;
@@ -192,9 +210,11 @@ CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& pr
         res[s].converged = res[s].residual_norm <= tol[s];
         active[s] = 0;
         --n_active;
+        stopped = true;
       }
     }
     if (n_active == 0) break;
+    if (stopped) publish();
     precondition(r, z);
     cg_detail::segment_dots(space, sums, r, z, rz_new);
     for (int s = 0; s < n_seg; ++s) {

@@ -66,14 +66,18 @@ void update_tension_stiffness(const ExecutionSpace& space, const MeshBuffers<Mem
 // out += Δt K_tension v.
 template <class ExecutionSpace, class MemorySpace, class Vector>
 void apply_tension_stiffness(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                             const TensionStiffness<MemorySpace>& ts, const Vector& v, const Vector& out) {
+                             const TensionStiffness<MemorySpace>& ts, const Vector& v, const Vector& out,
+                             const CellFlags<MemorySpace>& active = {}) {
   const auto tri = mesh.tri;
+  const auto tri_cell = mesh.tri_cell;
+  const auto node_cell = mesh.node_cell;
   const auto edge = ts.edge;
   const auto normal = ts.normal;
   const auto s = ts.s;
   Kokkos::parallel_for(
       "dcm::tension_stiffness::triangles", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_tris),
       KOKKOS_LAMBDA(const int t) {
+        if (skipped(active, tri_cell(t))) return;
         const Real3 n = load3(normal, t);
         Real3 acc{0, 0, 0};
         for (int k = 0; k < 3; ++k) {
@@ -87,6 +91,7 @@ void apply_tension_stiffness(const ExecutionSpace& space, const MeshBuffers<Memo
   Kokkos::parallel_for(
       "dcm::tension_stiffness::gather", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
+        if (skipped(active, node_cell(i))) return;
         Real3 acc{0, 0, 0};
         for (int q = offsets(i); q < offsets(i + 1); ++q) {
           const int t = corners(q) / 3, k = corners(q) % 3;

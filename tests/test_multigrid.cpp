@@ -92,8 +92,8 @@ TEST(Multigrid, RestrictionIsTheTransposeOfProlongation) {
     const int nf = s.mg.levels[l].a.n_rows, nc = s.mg.levels[l + 1].a.n_rows;
     const Vector u = Preconditioned::random_vector_of(nc, 3), w = Preconditioned::random_vector_of(nf, 4);
     Vector pu("pu", nf), rw("rw", nc);
-    mg_detail::prolong_add(space, s.mg.levels[l], u, pu);
-    mg_detail::restrict_residual(space, s.mg.levels[l], w, rw);
+    mg_detail::prolong_add(space, s.mg.levels[l], u, pu, {});
+    mg_detail::restrict_residual(space, s.mg.levels[l], s.mg.levels[l + 1], w, rw, {});
     const double wPu = dot_host(to_host_vector(w), to_host_vector(pu));
     const double Rwu = dot_host(to_host_vector(rw), to_host_vector(u));
     EXPECT_NEAR(wPu, Rwu, 1e-12 * std::fabs(wPu));
