@@ -111,7 +111,7 @@ void run_case(const std::string& space_name, int threads, const std::string& kin
     for (int i : right) f(i, 0) = 100e-12 / right.size();
     Kokkos::deep_copy(model.external_force(), f);
   }
-  dcm::TimeStepper<Exec> stepper(n, dcm::steps_from_scene(scene));
+  dcm::TimeStepper<Exec> stepper(model, dcm::steps_from_scene(scene));
   const dcm::CgSettings cg = dcm::cg_settings_from_scene(scene);
   for (int s = 0; s < o.warmup; ++s) stepper.step(model, cg, 1.0, [](double) {});
   g_times.seconds.clear();

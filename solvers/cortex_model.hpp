@@ -211,10 +211,27 @@ class CortexModel {
     const int b = mesh_.host_cell_node_begin.at(cell), e = mesh_.host_cell_node_begin.at(cell + 1);
     return std::vector<double>(all.begin() + 3 * b, all.begin() + 3 * e);
   }
+  // Writes flat [n][3] values into a cell's nodes.
+  void set_cell_slice(const Vector& v, int cell, const std::vector<double>& values) const {
+    auto all = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), v);
+    const int b = mesh_.host_cell_node_begin.at(cell), e = mesh_.host_cell_node_begin.at(cell + 1);
+    if (values.size() != 3 * static_cast<std::size_t>(e - b))
+      throw std::invalid_argument("set_cell_slice: " + std::to_string(values.size() / 3) +
+                                  " nodes for a cell of " + std::to_string(e - b));
+    for (int i = b; i < e; ++i)
+      for (int d = 0; d < 3; ++d) all(i, d) = values[3 * (i - b) + d];
+    Kokkos::deep_copy(v, all);
+  }
   void restore_state(const Checkpoint& c) {
     const std::size_t size = 3 * static_cast<std::size_t>(mesh_.n_nodes);
     from_host_vector(mesh_.x, c.array("model.x", size));
     from_host_vector(velocity_, c.array("model.v", size));
+    update_geometry(space_, mesh_, geo_, params_.h_min);
+  }
+  // One cell's state from a checkpoint of it (save_cell_state()).
+  void restore_cell_state(const Checkpoint& c, int cell) {
+    set_cell_slice(mesh_.x, cell, c.array("model.x"));
+    set_cell_slice(velocity_, cell, c.array("model.v"));
     update_geometry(space_, mesh_, geo_, params_.h_min);
   }
   // Rest-state edits for shape finding (apps/deflate): every cell's target volume times `factor` (no-op

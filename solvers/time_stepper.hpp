@@ -3,11 +3,20 @@
 // adaptive steps with error control, and in both cases step halving when a FENE bond would come too close to
 // d_max. Owns the simulated time. Design: docs/model/time_stepping.md.
 //
+// Per cell (the batched engine, docs/SCANS.md): every cell of the model keeps its own time, step, error
+// estimate, rejections and halvings, and takes exactly the steps it takes alone: the same decisions in the
+// same order, made per cell, with the solves of the other cells frozen while one cell redoes or halves its
+// step. A cell whose cap is 0 (it reached its own t_end) does not step. A single run is a batch of one (the
+// scalar step() below).
+//
 // Adaptive steps (settings.adaptive): the local error of the Euler step x₁ = x₀ + h v(x₀) is estimated
 // against Heun's x₀ + h (v(x₀) + v(x₁))/2: e = (h/2) max_i |v_i(x₁) − v_i(x₀)| (m). v(x₁) is the next step's
 // velocity, so the estimate costs no extra solve (first same as last). If e > tol the previous step is taken
 // again, shorter; otherwise the next step is h · min(2, max(0.2, 0.9 √(tol/e))), within [dt_min, dt_max].
 #include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "core/checkpoint.hpp"
 #include "core/errors.hpp"
@@ -41,112 +50,189 @@ class TimeStepper {
  public:
   using Model = CortexModel<ExecutionSpace>;
   using Vector = typename Model::Vector;
+  using Mem = typename Model::Mem;
 
-  TimeStepper(int n_nodes, const TimeStepSettings& settings)
+  TimeStepper(const Model& model, const TimeStepSettings& settings)
       : settings_(settings),
-        h_next_(settings.dt),
-        x_prev_(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::stepper::x_prev"), n_nodes),
-        v_prev_(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::stepper::v_prev"), n_nodes) {}
+        n_(model.n_cells()),
+        t_(n_, 0.0),
+        h_next_(n_, settings.dt),
+        h_prev_(n_, 0.0),
+        has_prev_(n_, 0),
+        x_prev_(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::batch::x_prev"), model.mesh().n_nodes),
+        v_prev_(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::batch::v_prev"), model.mesh().n_nodes),
+        cell_h_(std::vector<double>(n_, 0.0), "dcm::batch::h") {}
 
-  double time() const { return t_; }
-  double next_step() const { return h_next_; }
   const TimeStepSettings& settings() const { return settings_; }
+  double time(int c) const { return t_.at(c); }
+  double next_step(int c) const { return h_next_.at(c); }
+  int n_cells() const { return n_; }
 
-  // Everything the next step depends on, for a bit-identical restart (the settings come from the scene).
-  void save_state(Checkpoint& c) const {
-    c.put("stepper.t", t_);
-    c.put("stepper.h_next", h_next_);
-    c.put("stepper.h_prev", h_prev_);
-    c.put("stepper.has_prev", has_prev_ ? 1.0 : 0.0);
-    c.put("stepper.x_prev", to_host_vector(x_prev_));
-    c.put("stepper.v_prev", to_host_vector(v_prev_));
+  // Cell c's stepper state: a batch member's checkpoint is that of its run alone.
+  void save_cell_state(Checkpoint& ck, const Model& model, int c) const {
+    ck.put("stepper.t", t_[c]);
+    ck.put("stepper.h_next", h_next_[c]);
+    ck.put("stepper.h_prev", h_prev_[c]);
+    ck.put("stepper.has_prev", has_prev_[c] ? 1.0 : 0.0);
+    ck.put("stepper.x_prev", model.cell_slice(x_prev_, c));
+    ck.put("stepper.v_prev", model.cell_slice(v_prev_, c));
   }
-  void restore_state(const Checkpoint& c) {
-    t_ = c.scalar("stepper.t");
-    h_next_ = c.scalar("stepper.h_next");
-    h_prev_ = c.scalar("stepper.h_prev");
-    has_prev_ = c.scalar("stepper.has_prev") != 0;
-    const std::size_t size = 3 * x_prev_.extent(0);
-    from_host_vector(x_prev_, c.array("stepper.x_prev", size));
-    from_host_vector(v_prev_, c.array("stepper.v_prev", size));
+  // Cell c's stepper state from a checkpoint of it.
+  void restore_cell_state(const Checkpoint& ck, const Model& model, int c) {
+    t_.at(c) = ck.scalar("stepper.t");
+    h_next_[c] = ck.scalar("stepper.h_next");
+    h_prev_[c] = ck.scalar("stepper.h_prev");
+    has_prev_[c] = ck.scalar("stepper.has_prev") != 0;
+    model.set_cell_slice(x_prev_, c, ck.array("stepper.x_prev"));
+    model.set_cell_slice(v_prev_, c, ck.array("stepper.v_prev"));
   }
 
-  // One step, at most h_cap long (the caller's t_end). observe(h) is called once, after the velocity of the
-  // step is known and before the positions move (the caller samples energies there); h is the step about to
-  // be taken (a halving may still shorten it).
+  // A one-cell model: the time, and one step at most h_cap long; observe(h) is called once, after the
+  // velocity of the step is known and before the positions move (a halving may still shorten h).
+  double time() const { return t_.at(0); }
   template <class Observe>
   StepReport step(Model& model, const CgSettings& cg, double h_cap, Observe&& observe) {
-    StepReport rep;
-    double h = std::min(h_next_, h_cap);
-    model.compute_forces();
-    solve(model, cg, h, rep);
-    double h_solved = h;  // the step the implicit terms of the last solve were built for
-    if (settings_.adaptive && has_prev_) {
-      for (;;) {
-        const double err = 0.5 * h_prev_ * max_difference(model.space(), model.velocity(), v_prev_);
-        rep.error_m = err;
-        if (err <= settings_.error_tol_m || h_prev_ <= settings_.dt_min * (1 + 1e-12)) {
-          h = std::min(grow(h_prev_, err), h_cap);
-          break;
-        }
-        // Take the previous step again, shorter: x = x_prev + h' v_prev.
-        const double shorter = std::max(settings_.dt_min, h_prev_ * shrink_factor(err));
-        t_ += shorter - h_prev_;
-        h_prev_ = shorter;
-        redo_previous_step(model);
-        ++rep.rejections;
-        model.compute_forces();
-        h_solved = h_prev_;
-        solve(model, cg, h_solved, rep);
+    if (n_ != 1)
+      throw std::logic_error("TimeStepper::step(h_cap): the model has several cells; give a cap per cell");
+    return step(model, cg, std::vector<double>{h_cap},
+                [&](const std::vector<double>& h) { observe(h[0]); })[0];
+  }
+
+  // One step of every cell c with h_cap[c] > 0, at most h_cap[c] long. observe(h) is called once, after the
+  // velocities are known and before the positions move, with each cell's step (0: not stepping).
+  // Returns one report per cell (all zero for a cell that did not step).
+  template <class Observe>
+  std::vector<StepReport> step(Model& model, const CgSettings& cg, const std::vector<double>& h_cap,
+                               Observe&& observe) {
+    if (static_cast<int>(h_cap.size()) != n_) throw std::invalid_argument("TimeStepper: one cap per cell");
+    std::vector<StepReport> rep(n_);
+    std::vector<char> stepping(n_, 0);
+    std::vector<double> h(n_, 0.0), h_solved(n_, 0.0);
+    for (int c = 0; c < n_; ++c)
+      if (h_cap[c] > 0) {
+        stepping[c] = 1;
+        h[c] = std::min(h_next_[c], h_cap[c]);
       }
-      // The implicit terms of the solve (bonds, bending, global constraints) depend on h: solve again when
-      // the step changed by more than 10%.
-      if (std::fabs(h - h_solved) > 0.1 * h_solved) solve(model, cg, h, rep);
+    model.compute_forces();
+    solve(model, cg, stepping, h, rep);
+    h_solved = h;
+    if (settings_.adaptive) {
+      std::vector<char> checking(n_, 0);
+      for (int c = 0; c < n_; ++c) checking[c] = stepping[c] && has_prev_[c];
+      while (any(checking)) {
+        const std::vector<double> dv = velocity_change(model);
+        std::vector<char> rejected(n_, 0);
+        for (int c = 0; c < n_; ++c) {
+          if (!checking[c]) continue;
+          const double err = 0.5 * h_prev_[c] * dv[c];
+          rep[c].error_m = err;
+          if (err <= settings_.error_tol_m || h_prev_[c] <= settings_.dt_min * (1 + 1e-12)) {
+            h[c] = std::min(grow(h_prev_[c], err), h_cap[c]);
+            checking[c] = 0;
+            continue;
+          }
+          const double shorter = std::max(settings_.dt_min, h_prev_[c] * shrink_factor(err));
+          t_[c] += shorter - h_prev_[c];
+          h_prev_[c] = shorter;
+          rejected[c] = 1;
+          ++rep[c].rejections;
+        }
+        if (!any(rejected)) break;
+        redo_previous_step(model, rejected);
+        model.compute_forces();
+        for (int c = 0; c < n_; ++c)
+          if (rejected[c]) h_solved[c] = h_prev_[c];
+        solve(model, cg, rejected, h_solved, rep);
+      }
+      // The implicit terms depend on h: solve again where the step changed by more than 10%.
+      std::vector<char> again(n_, 0);
+      for (int c = 0; c < n_; ++c)
+        again[c] = stepping[c] && has_prev_[c] && std::fabs(h[c] - h_solved[c]) > 0.1 * h_solved[c];
+      if (any(again)) solve(model, cg, again, h, rep);
     }
     observe(h);
     Kokkos::deep_copy(x_prev_, model.positions());
     Kokkos::deep_copy(v_prev_, model.velocity());
-    // A step may take the most extended bond at most half-way from its length to d_max (and always to
-    // 0.999 d_max): bonds approach x_max, as the paper's spread cells do, but never cross it.
-    const double ext_start = model.max_bond_extension();
-    const double ext_limit = std::max(0.999, ext_start + 0.5 * (1.0 - ext_start));
-    for (;;) {
-      model.advance(h);
-      if (model.max_bond_extension() < ext_limit) break;
-      if (rep.halvings == settings_.max_halvings)
-        throw NumericalError("a bond stays at its maximum length d_max even with the time step halved " +
-                             std::to_string(settings_.max_halvings) + " times");
-      Kokkos::deep_copy(model.positions(), x_prev_);
-      h *= 0.5;
-      ++rep.halvings;
+    const std::vector<double> ext_start = model.cell_max_bond_extension();
+    std::vector<double> ext_limit(n_);
+    for (int c = 0; c < n_; ++c) ext_limit[c] = std::max(0.999, ext_start[c] + 0.5 * (1.0 - ext_start[c]));
+    std::vector<char> moving = stepping;
+    while (any(moving)) {
+      advance(model, moving, h);
+      const std::vector<double> ext = model.cell_max_bond_extension();
+      std::vector<char> over(n_, 0);
+      for (int c = 0; c < n_; ++c) {
+        if (!moving[c] || ext[c] < ext_limit[c]) continue;
+        if (rep[c].halvings == settings_.max_halvings)
+          throw NumericalError(which(c) +
+                               "a bond stays at its maximum length d_max even with the time step halved " +
+                               std::to_string(settings_.max_halvings) + " times");
+        over[c] = 1;
+        h[c] *= 0.5;
+        ++rep[c].halvings;
+      }
+      if (any(over)) restore_positions(model, over);
+      moving = over;
     }
-    t_ += h;
-    h_prev_ = h;
-    has_prev_ = true;
-    // Fixed steps return to dt after a halving; adaptive ones start the next step's solve with this step's
-    // length (the error estimate then sets it).
-    h_next_ = settings_.adaptive ? h : settings_.dt;
-    rep.h = h;
+    for (int c = 0; c < n_; ++c) {
+      if (!stepping[c]) continue;
+      t_[c] += h[c];
+      h_prev_[c] = h[c];
+      has_prev_[c] = 1;
+      h_next_[c] = settings_.adaptive ? h[c] : settings_.dt;
+      rep[c].h = h[c];
+    }
     return rep;
   }
 
  private:
-  // The velocity solve with the implicit terms of a step h; a solve that does not converge (the implicit
-  // stiffness of a bond close to d_max makes Γ + h K badly conditioned) is retried with h/2.
-  void solve(Model& model, const CgSettings& cg, double& h, StepReport& rep) {
-    for (;;) {
-      const CgResult r = model.solve_velocity(cg, h, false);
-      rep.iterations += r.iterations;
-      if (r.converged) return;
-      if (rep.halvings >= settings_.max_halvings || rep.unconverged_solves >= settings_.max_solve_halvings)
-        throw NumericalError(Model::unconverged_message(r, cg) + ", even with the time step halved " +
-                             std::to_string(rep.halvings) + " times; largest force at node " +
-                             std::to_string(model.largest_force_node()));
-      h *= 0.5;
-      ++rep.halvings;
-      ++rep.unconverged_solves;
+  std::string which(int c) const { return n_ > 1 ? "cell " + std::to_string(c) + ": " : ""; }
+  static bool any(const std::vector<char>& flags) {
+    for (const char f : flags)
+      if (f) return true;
+    return false;
+  }
+
+  // The velocity solve of the cells in `set`, each with its step h[c]; a solve that does not converge (the
+  // implicit stiffness of a bond close to d_max makes Γ + h K badly conditioned) is retried with h/2. The
+  // other cells keep their velocity.
+  void solve(Model& model, const CgSettings& cg, const std::vector<char>& set, std::vector<double>& h,
+             std::vector<StepReport>& rep) {
+    std::vector<char> pending = set;
+    while (any(pending)) {
+      std::vector<char> frozen(n_);
+      std::vector<double> dt(n_);
+      for (int c = 0; c < n_; ++c) {
+        frozen[c] = !pending[c];
+        dt[c] = pending[c] ? h[c] : h_next_[c];  // a frozen cell's step only keeps the operator's structure
+      }
+      model.solve_velocity(cg, dt, &frozen, false);
+      const std::vector<CgResult>& r = model.cell_solves();
+      for (int c = 0; c < n_; ++c) {
+        if (!pending[c]) continue;
+        rep[c].iterations += r[c].iterations;
+        if (r[c].converged) {
+          pending[c] = 0;
+          continue;
+        }
+        if (!(r[c].residual_norm < INFINITY))
+          throw NumericalError(
+              "cell " + std::to_string(c) +
+              ": conjugate gradients diverged: the residual is not finite; the largest force is "
+              "at node " +
+              std::to_string(model.largest_force_node()));
+        if (rep[c].halvings >= settings_.max_halvings ||
+            rep[c].unconverged_solves >= settings_.max_solve_halvings)
+          throw NumericalError("cell " + std::to_string(c) + ": " + Model::unconverged_message(r[c], cg) +
+                               ", even with the time step halved " + std::to_string(rep[c].halvings) +
+                               " times");
+        h[c] *= 0.5;
+        ++rep[c].halvings;
+        ++rep[c].unconverged_solves;
+      }
     }
   }
+
   double grow(double h, double err) const {
     const double factor =
         err > 0 ? std::min(2.0, std::max(0.2, 0.9 * std::sqrt(settings_.error_tol_m / err))) : 2.0;
@@ -155,33 +241,60 @@ class TimeStepper {
   double shrink_factor(double err) const {
     return std::min(0.9, std::max(0.2, 0.9 * std::sqrt(settings_.error_tol_m / err)));
   }
-  void redo_previous_step(Model& model) {
-    const auto x = model.positions();
-    const auto x0 = x_prev_, v0 = v_prev_;
-    const double h = h_prev_;
-    Kokkos::parallel_for(
-        "dcm::stepper::redo", Kokkos::RangePolicy<ExecutionSpace>(model.space(), 0, x.extent(0)),
+
+  // Per cell, max_i |v_i − v_prev_i| over its nodes.
+  std::vector<double> velocity_change(const Model& model) const {
+    const auto a = model.velocity();
+    const auto b = v_prev_;
+    std::vector<double> m;
+    segmented_max(
+        "dcm::batch::max_velocity_change", model.space(), model.mesh().node_sums,
         KOKKOS_LAMBDA(const int i) {
-          for (int d = 0; d < 3; ++d) x(i, d) = x0(i, d) + h * v0(i, d);
-        });
-  }
-  static double max_difference(const ExecutionSpace& space, const Vector& a, const Vector& b) {
-    double m = 0;
-    Kokkos::parallel_reduce(
-        "dcm::stepper::max_velocity_change", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.extent(0)),
-        KOKKOS_LAMBDA(const int i, double& acc) {
           const double dx = a(i, 0) - b(i, 0), dy = a(i, 1) - b(i, 1), dz = a(i, 2) - b(i, 2);
-          const double d = dx * dx + dy * dy + dz * dz;
-          if (d > acc) acc = d;
+          return dx * dx + dy * dy + dz * dz;
         },
-        Kokkos::Max<double>(m));
-    return std::sqrt(m);
+        m);
+    for (double& v : m) v = std::sqrt(v);
+    return m;
+  }
+
+  // x = x_prev + h_prev v_prev on the flagged cells.
+  void redo_previous_step(Model& model, const std::vector<char>& cells) {
+    move_cells(model, cells, h_prev_, x_prev_, v_prev_, false, "dcm::stepper::redo");
+  }
+  // x += h v on the flagged cells (forward Euler, paper eq. 32).
+  void advance(Model& model, const std::vector<char>& cells, const std::vector<double>& h) {
+    move_cells(model, cells, h, model.positions(), model.velocity(), false, "dcm::integrator::euler");
+  }
+  // x = x_prev on the flagged cells.
+  void restore_positions(Model& model, const std::vector<char>& cells) {
+    move_cells(model, cells, std::vector<double>(n_, 1.0), x_prev_, v_prev_, true, "dcm::stepper::restore");
+  }
+  // On the nodes of the flagged cells: x = base + s_c dir (copy: x = base).
+  void move_cells(Model& model, const std::vector<char>& cells, const std::vector<double>& s,
+                  const Vector& base, const Vector& dir, bool copy, const char* label) {
+    std::vector<double> factor(n_, 0.0);
+    for (int c = 0; c < n_; ++c)
+      if (cells[c]) factor[c] = s[c];
+    cell_h_.assign(factor);
+    const auto x = model.positions();
+    const auto f = cell_h_.values;
+    const auto node_cell = model.mesh().node_cell;
+    Kokkos::parallel_for(
+        label, Kokkos::RangePolicy<ExecutionSpace>(model.space(), 0, x.extent(0)),
+        KOKKOS_LAMBDA(const int i) {
+          const double fc = f(node_cell(i));
+          if (fc == 0) return;
+          for (int d = 0; d < 3; ++d) x(i, d) = copy ? base(i, d) : base(i, d) + fc * dir(i, d);
+        });
   }
 
   TimeStepSettings settings_;
-  double t_ = 0, h_next_ = 0, h_prev_ = 0;
-  bool has_prev_ = false;
+  int n_;
+  std::vector<double> t_, h_next_, h_prev_;
+  std::vector<char> has_prev_;
   Vector x_prev_, v_prev_;
+  PerCell<double, Mem> cell_h_;
 };
 
 }  // namespace dcm

@@ -60,7 +60,7 @@ TEST(TimeStepper, FixedStepsAreTheForwardEulerLoop) {
   perturb(b, 0.04e-6, 7);
   TimeStepSettings s;
   s.dt = 6e-6;
-  TimeStepper<Exec> stepper(a.mesh().n_nodes, s);
+  TimeStepper<Exec> stepper(a, s);
   int observed = 0;
   for (int k = 0; k < 50; ++k) {
     const StepReport rep = stepper.step(a, tight(), INFINITY, [&](double h) {
@@ -89,7 +89,7 @@ TEST(TimeStepper, AdaptiveErrorFollowsTheTolerance) {
   auto run = [&](TimeStepSettings s, int& steps) {
     CortexModel<Exec> m(Exec(), {HostCell(sphere)}, table1());
     perturb(m, 0.04e-6, 11);
-    TimeStepper<Exec> stepper(m.mesh().n_nodes, s);
+    TimeStepper<Exec> stepper(m, s);
     steps = 0;
     while (stepper.time() < t_end * (1 - 1e-12)) {
       stepper.step(m, tight(), t_end - stepper.time(), [](double) {});
@@ -133,7 +133,7 @@ TEST(TimeStepper, UnconvergedSolveEndsInAClearErrorAfterTheHalvings) {
   perturb(m, 0.04e-6, 3);
   TimeStepSettings s;
   s.max_halvings = 4;
-  TimeStepper<Exec> stepper(m.mesh().n_nodes, s);
+  TimeStepper<Exec> stepper(m, s);
   CgSettings cg = tight();
   cg.max_iterations = 1;
   try {

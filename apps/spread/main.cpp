@@ -44,7 +44,7 @@
 #include "core/host_copy.hpp"
 #include "core/json_writer.hpp"
 #include "core/kokkos_compat.hpp"
-#include "solvers/batch_stepper.hpp"
+#include "solvers/time_stepper.hpp"
 
 namespace dcm {
 namespace {
@@ -275,7 +275,7 @@ std::string batch_difference(const Member& a, const Member& b) {
 }
 
 using Model = CortexModel<Exec>;
-using Stepper = BatchStepper<Exec>;
+using Stepper = TimeStepper<Exec>;
 
 void write_frame(Member& m, Model& model, NodeFields<Exec::memory_space>& fields, double t) {
   model.node_fields(fields);
@@ -400,7 +400,7 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
 
 // Runs the members as one batch (one member: the ordinary run). Forward Euler at the scene's fixed Δt (the
 // paper's) or with adaptive, error-controlled steps, each member with its own steps; a step that would take
-// a bond too close to d_max is taken again with half the step (solvers/batch_stepper.hpp).
+// a bond too close to d_max is taken again with half the step (solvers/time_stepper.hpp).
 void run_members(std::vector<Member>& ms, bool quiet, int threads) {
   std::signal(SIGINT, on_signal);  // from the start: a stop during the set-up ends after the first step
   std::signal(SIGTERM, on_signal);
@@ -426,26 +426,32 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
   KokkosSession kokkos(threads);
   const auto wall0 = std::chrono::steady_clock::now();
 
-  std::vector<HostCell> cells;
-  std::vector<MechanicsParams> params;
-  int first = 0;
-  for (std::size_t k = 0; k < ms.size(); ++k) {
-    Member& m = ms[k];
-    cells.emplace_back(m.mesh);
-    params.push_back(m.params);
-    m.cell = static_cast<int>(k);
-    m.first_node = first;
-    m.n = static_cast<int>(m.mesh.nodes.size());
-    first += m.n;
-  }
-  Model model(Exec(), cells, params);
+  // The model of the members that are still running, each a cell (its rest state from its own mesh).
+  const auto make_model = [&](const std::vector<Member*>& running) {
+    std::vector<HostCell> cells;
+    std::vector<MechanicsParams> params;
+    int first = 0;
+    for (std::size_t k = 0; k < running.size(); ++k) {
+      Member& m = *running[k];
+      cells.emplace_back(m.mesh);
+      params.push_back(m.params);
+      m.cell = static_cast<int>(k);
+      m.first_node = first;
+      m.n = static_cast<int>(m.mesh.nodes.size());
+      first += m.n;
+    }
+    return Model(Exec(), cells, params);
+  };
+  std::vector<Member*> all;
+  for (Member& m : ms) all.push_back(&m);
+  Model model = make_model(all);
   NodeFields<Exec::memory_space> fields(model.mesh().n_nodes);
   Stepper stepper(model, ms.front().steps);
   for (Member& m : ms) {
     if (m.restart) {  // a restart is a one-member run
       const Checkpoint& c = *m.restart;
-      model.restore_state(c);
-      stepper.restore_state(c);
+      model.restore_cell_state(c, m.cell);
+      stepper.restore_cell_state(c, model, m.cell);
       const auto progress = m.p.fields();
       const std::vector<double>& saved = c.array("app.progress", progress.size());
       for (std::size_t i = 0; i < progress.size(); ++i) *progress[i] = saved[i];
@@ -493,13 +499,12 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
                 kokkos_description().c_str());
 
   auto last_progress = std::chrono::steady_clock::now();
-  const std::size_t n_members = ms.size();
-  std::vector<double> cap(n_members), e0, pc, dis, e1, area_cells, load_cells;
+  std::vector<double> cap, e0, pc, dis, e1, area_cells, load_cells;
   long long batch_steps = 0;
   for (;;) {
     bool any_running = false;
+    cap.assign(model.n_cells(), 0.0);
     for (Member& m : ms) {
-      cap[m.cell] = 0;
       if (m.last || m.done) continue;
       any_running = true;
       m.t = stepper.time(m.cell);
@@ -516,7 +521,7 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
         bool any_sample = false;
         for (Member& m : ms) {
           m.sample = false;
-          if (cap[m.cell] == 0) continue;
+          if (m.done || cap[m.cell] == 0) continue;
           const double t = m.t;
           Progress& p = m.p;
           const auto next_figure = static_cast<std::size_t>(p.next_figure);
@@ -552,7 +557,7 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
     }
     ++batch_steps;
     bool any_row = false;
-    for (Member& m : ms) any_row = any_row || (cap[m.cell] > 0 && m.sample);
+    for (Member& m : ms) any_row = any_row || (!m.done && cap[m.cell] > 0 && m.sample);
     if (any_row) {  // after the step: each sampled member's row
       model.energy(&e1);
       model.contact_area(&area_cells);
@@ -563,7 +568,7 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
     const std::vector<double> cell_volume =
         any_row ? to_host_vector(model.geometry().cell_volume) : std::vector<double>();
     for (Member& m : ms) {
-      if (cap[m.cell] == 0) continue;
+      if (m.done || cap[m.cell] == 0) continue;
       const StepReport& r = rep[m.cell];
       Progress& p = m.p;
       p.step += 1;
@@ -652,9 +657,32 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
         write_checkpoint_now(m, model, stepper, seconds_since(wall0));
         m.last_checkpoint = std::chrono::steady_clock::now();
       }
-    // Members that reached their t_end: final state written (their cell no longer steps).
+    // Members that reached their t_end: final state written; they leave the model, and the others continue
+    // in a model of their own cells, bit for bit (nothing a cell computes depends on the other cells, and
+    // each cell's rest state comes from its member's mesh): a finished cell costs nothing more.
+    bool left = false;
     for (Member& m : ms)
-      if (!m.done && m.last) finish_member(m, model, stepper, fields, seconds_since(wall0));
+      if (!m.done && m.last) {
+        finish_member(m, model, stepper, fields, seconds_since(wall0));
+        left = true;
+      }
+    std::vector<Member*> running;
+    for (Member& m : ms)
+      if (!m.done) running.push_back(&m);
+    if (left && !running.empty()) {
+      std::vector<Checkpoint> state(running.size());
+      for (std::size_t k = 0; k < running.size(); ++k) {
+        model.save_cell_state(state[k], running[k]->cell);
+        stepper.save_cell_state(state[k], model, running[k]->cell);
+      }
+      model = make_model(running);
+      fields = NodeFields<Exec::memory_space>(model.mesh().n_nodes);
+      stepper = Stepper(model, ms.front().steps);
+      for (std::size_t k = 0; k < running.size(); ++k) {
+        model.restore_cell_state(state[k], static_cast<int>(k));
+        stepper.restore_cell_state(state[k], model, static_cast<int>(k));
+      }
+    }
   }
   // The final state of the members still open (interrupted or stopped at --max-steps).
   for (Member& m : ms)
