@@ -423,9 +423,10 @@ class CortexModel {
                               dt_, *global_);
     if (params_.dashpot == 0 && params_.dashpot_transverse == 0 && !friction_.substrate && !implicit &&
         !implicit_bending && !implicit_bonds && !implicit_tension) {
-      apply_block_jacobi(space_, friction_, force_, velocity_);
-      CgResult r;
+      apply_block_jacobi(space_, friction_, force_, velocity_);  // exact: Γ is block-diagonal (a frozen
+      CgResult r;                                                // cell gets the same v again)
       r.converged = true;
+      cg_.segment_results.assign(mesh_.n_cells, r);
       return r;
     }
     const CgResult r = pcg_solve(

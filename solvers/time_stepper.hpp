@@ -217,15 +217,15 @@ class TimeStepper {
         }
         if (!(r[c].residual_norm < INFINITY))
           throw NumericalError(
-              "cell " + std::to_string(c) +
-              ": conjugate gradients diverged: the residual is not finite; the largest force is "
+              which(c) +
+              "conjugate gradients diverged: the residual is not finite; the largest force is "
               "at node " +
               std::to_string(model.largest_force_node()));
         if (rep[c].halvings >= settings_.max_halvings ||
             rep[c].unconverged_solves >= settings_.max_solve_halvings)
-          throw NumericalError("cell " + std::to_string(c) + ": " + Model::unconverged_message(r[c], cg) +
+          throw NumericalError(which(c) + Model::unconverged_message(r[c], cg) +
                                ", even with the time step halved " + std::to_string(rep[c].halvings) +
-                               " times");
+                               " times; largest force at node " + std::to_string(model.largest_force_node()));
         h[c] *= 0.5;
         ++rep[c].halvings;
         ++rep[c].unconverged_solves;
