@@ -429,20 +429,21 @@ class CortexModel {
       cg_.segment_results.assign(mesh_.n_cells, r);
       return r;
     }
+    const CellFlags<Mem> active = mesh_.n_cells > 1 ? cg_.active : CellFlags<Mem>();
     const CgResult r = pcg_solve(
         space_,
-        // Only the cells still iterating (a batch: the others have converged or are not stepping).
+        // Only the cells still iterating (a batch: the others have converged or are not stepping; one cell:
+        // no mask, no per-row check).
         [&](const Vector& in, const Vector& out) {
-          apply_friction(space_, mesh_, friction_, in, out, cg_.active);
-          if (implicit) apply_global_stiffness(space_, mesh_, *global_, in, out, cg_.active);
+          apply_friction(space_, mesh_, friction_, in, out, active);
+          if (implicit) apply_global_stiffness(space_, mesh_, *global_, in, out, active);
           if (implicit_bending)
-            apply_bending_stiffness(space_, mesh_, *hinges_, *bending_stiffness_, in, out, cg_.active);
-          if (implicit_tension)
-            apply_tension_stiffness(space_, mesh_, *tension_stiffness_, in, out, cg_.active);
+            apply_bending_stiffness(space_, mesh_, *hinges_, *bending_stiffness_, in, out, active);
+          if (implicit_tension) apply_tension_stiffness(space_, mesh_, *tension_stiffness_, in, out, active);
         },
         [&](const Vector& in, const Vector& out) {
           if (multigrid_)
-            apply_multigrid(space_, *multigrid_, in, out, cg_.active);
+            apply_multigrid(space_, *multigrid_, in, out, active);
           else
             apply_block_jacobi(space_, friction_, in, out);
         },
