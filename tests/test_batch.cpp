@@ -10,6 +10,7 @@
 
 #include "core/host_copy.hpp"
 #include "solvers/time_stepper.hpp"
+#include "tests/model_params.hpp"
 
 namespace dcm {
 namespace {
@@ -19,13 +20,7 @@ using Exec = Kokkos::DefaultExecutionSpace;
 // Table 1 on a plane the sphere of radius r just overlaps (contact radius a), with the spreading scene's
 // solver options (multigrid, implicit bending and tension, lumped substrate friction).
 MechanicsParams spreading(double r, double a) {
-  MechanicsParams p;
-  p.bonds = {3.2e-6, 2.05};
-  p.k_b = 240e-21;
-  p.k_area_local = 6e-3;
-  p.k_area_global = 6e-3;
-  p.k_volume = 1e4;
-  p.dashpot = 1.5e-6;
+  MechanicsParams p = test_params::table1_cortex();
   p.multigrid = true;
   p.implicit_bending = true;
   p.implicit_tension = true;

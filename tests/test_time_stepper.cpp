@@ -9,23 +9,14 @@
 
 #include "core/host_copy.hpp"
 #include "solvers/time_stepper.hpp"
+#include "tests/model_params.hpp"
 
 namespace dcm {
 namespace {
 
 using Exec = Kokkos::DefaultExecutionSpace;
 
-MechanicsParams table1() {
-  MechanicsParams p;
-  p.bonds = {3.2e-6, 2.05};
-  p.k_b = 240e-21;
-  p.k_area_local = 6e-3;
-  p.k_area_global = 6e-3;
-  p.k_volume = 1e4;
-  p.dashpot = 1.5e-6;
-  p.viscosity = 0.8e-3;
-  return p;
-}
+MechanicsParams table1() { return test_params::table1_cortex(); }
 
 // A 162-node cell whose rest state is the sphere, displaced by up to `amplitude` per coordinate.
 void perturb(CortexModel<Exec>& model, double amplitude, unsigned seed) {
