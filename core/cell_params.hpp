@@ -2,24 +2,36 @@
 // Constants that may differ from cell to cell (the batched engine: docs/SCANS.md, "The batched engine:
 // design", point 1). Kernels read a constant for the cell of the element they work on with
 // cell_value(k, cell): k is either one value for every cell (a double or a parameter struct, as a single
-// run passes it) or a PerCell table with a row per cell. Both give the same arithmetic for a cell, so a
-// cell of a batch computes exactly what it computes alone.
+// run passes it) or a CellTable, the device-side view of a PerCell (`per_cell.table()`: Views and plain
+// data only, so kernels capture nothing of the host). Both give the same arithmetic for a cell, so a cell of
+// a batch computes exactly what it computes alone.
 #include <Kokkos_Core.hpp>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace dcm {
 
+// What kernels capture: the rows on the device, and whether any row is non-zero (for host-side decisions).
+template <class T, class MemorySpace>
+struct CellTable {
+  Kokkos::View<T*, Kokkos::LayoutRight, MemorySpace> values;
+  bool nonzero = true;
+};
+
+// A table of one T per cell, owned on the host side.
 template <class T, class MemorySpace>
 struct PerCell {
   Kokkos::View<T*, Kokkos::LayoutRight, MemorySpace> values;
   std::vector<T> host;  // the same rows, for host-side decisions (is a term on anywhere?)
+  typename Kokkos::View<T*, Kokkos::LayoutRight, MemorySpace>::HostMirror mirror;  // staging for assign()
   PerCell() = default;
   explicit PerCell(const std::vector<T>& rows, const char* label = "dcm::per_cell")
-      : values(Kokkos::view_alloc(Kokkos::WithoutInitializing, std::string(label)), rows.size()), host(rows) {
-    auto h = Kokkos::create_mirror_view(values);
-    for (std::size_t c = 0; c < rows.size(); ++c) h(c) = rows[c];
-    Kokkos::deep_copy(values, h);
+      : values(Kokkos::view_alloc(Kokkos::WithoutInitializing, std::string(label)), rows.size()),
+        host(rows),
+        mirror(Kokkos::create_mirror_view(values)) {
+    for (std::size_t c = 0; c < rows.size(); ++c) mirror(c) = rows[c];
+    Kokkos::deep_copy(values, mirror);
   }
   // New rows of the same count (no allocation: for values that change every step).
   void assign(const std::vector<T>& rows) {
@@ -28,9 +40,16 @@ struct PerCell {
       return;
     }
     host = rows;
-    auto h = Kokkos::create_mirror_view(values);
-    for (std::size_t c = 0; c < rows.size(); ++c) h(c) = rows[c];
-    Kokkos::deep_copy(values, h);
+    for (std::size_t c = 0; c < rows.size(); ++c) mirror(c) = rows[c];
+    Kokkos::deep_copy(values, mirror);
+  }
+  CellTable<T, MemorySpace> table() const {
+    CellTable<T, MemorySpace> t{values, true};
+    if constexpr (std::is_arithmetic<T>::value) {
+      t.nonzero = false;
+      for (const T& k : host) t.nonzero = t.nonzero || k != 0;
+    }
+    return t;
   }
 };
 
@@ -41,7 +60,7 @@ KOKKOS_INLINE_FUNCTION const T& cell_value(const T& uniform, int) {
 }
 // Cell c's row.
 template <class T, class MemorySpace>
-KOKKOS_INLINE_FUNCTION T cell_value(const PerCell<T, MemorySpace>& table, int c) {
+KOKKOS_INLINE_FUNCTION T cell_value(const CellTable<T, MemorySpace>& table, int c) {
   return table.values(c);
 }
 
@@ -58,10 +77,8 @@ KOKKOS_INLINE_FUNCTION bool skipped(const Flags& active, int cell) {
 // Whether a constant is non-zero for some cell (a term with a zero constant everywhere is skipped).
 inline bool any_nonzero(double k) { return k != 0; }
 template <class MemorySpace>
-bool any_nonzero(const PerCell<double, MemorySpace>& table) {
-  for (const double k : table.host)
-    if (k != 0) return true;
-  return false;
+bool any_nonzero(const CellTable<double, MemorySpace>& table) {
+  return table.nonzero;
 }
 
 // One member of each cell's parameter struct as a table: member_table(cells, &P::k_b).

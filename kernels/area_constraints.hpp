@@ -91,7 +91,7 @@ void add_area_forces_impl(const ExecutionSpace& space, const MeshBuffers<MemoryS
 
 // Adds the area-constraint forces (N) into force (n_nodes x 3). Either constant may be 0; both 0 is a
 // no-op. Needs update_geometry() (tri_area, tri_normal, cell_area) on the current mesh.x.
-// k_a, k_d: one value each (N/m) or PerCell tables (core/cell_params.hpp).
+// k_a, k_d: one value each (N/m) or CellTables (PerCell::table(), core/cell_params.hpp).
 template <class ExecutionSpace, class MemorySpace, class KA, class KD>
 void add_area_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                      const GeometryBuffers<MemorySpace>& geo, const AreaRest<MemorySpace>& rest,

@@ -139,7 +139,7 @@ void set_hinge_rest_angles(const HingeRest<MemorySpace>& rest, const std::vector
 
 // force(i) += bending forces on node i: one pass over the hinges (gradient, -M and cos(theta - theta*) into
 // rest), then a gather over the node's CSR (hinge, role) list of F_a = -M dtheta/dx_a (no atomics).
-// k_b: one value (J) or a PerCell table (core/cell_params.hpp).
+// k_b: one value (J) or a CellTable (PerCell::table(), core/cell_params.hpp).
 template <class ExecutionSpace, class MemorySpace, class KB>
 void add_bending_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                         const HingeRest<MemorySpace>& rest, const KB& k_b,

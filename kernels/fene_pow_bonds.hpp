@@ -96,7 +96,7 @@ BondRest<MemorySpace> make_bond_rest(const ExecutionSpace& space, const MeshBuff
 
 // force(i) += sum over the bonds of node i of F_i (a gather over the node's CSR bond list: no atomics).
 // overstretched: set to -1 by the caller; receives the index of a bond that could not be evaluated.
-// params: one FenePowParams or a PerCell table of them (core/cell_params.hpp).
+// params: one FenePowParams or a CellTable of them (PerCell::table(), core/cell_params.hpp).
 template <class ExecutionSpace, class MemorySpace, class Params>
 void add_fene_pow_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                          const BondRest<MemorySpace>& rest, const Params& params,

@@ -104,7 +104,7 @@ KOKKOS_INLINE_FUNCTION Real3 nearest_point_in_triangle(Real3 p0, Real3 p1, Real3
 }
 
 // Per-triangle contact with the plane (needs update_geometry(): tri_area, tri_normal, the spheres).
-// params: one PlaneContactParams or a PerCell table of them (core/cell_params.hpp).
+// params: one PlaneContactParams or a CellTable of them (PerCell::table(), core/cell_params.hpp).
 template <class ExecutionSpace, class MemorySpace, class Params>
 void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                            const GeometryBuffers<MemorySpace>& geo, const Plane& plane, const Params& params,

@@ -51,7 +51,7 @@ VolumeRest<MemorySpace> make_volume_rest(const ExecutionSpace& space, const Mesh
 
 // Adds the volume-constraint forces (N) into force (n_nodes x 3); k_v = 0 is a no-op. Needs
 // update_geometry() (tri_area, tri_normal, cell_volume) on the current mesh.x.
-// k_v: one value (Pa) or a PerCell table (core/cell_params.hpp).
+// k_v: one value (Pa) or a CellTable (PerCell::table(), core/cell_params.hpp).
 template <class ExecutionSpace, class MemorySpace, class KV>
 void add_volume_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                        const GeometryBuffers<MemorySpace>& geo, const VolumeRest<MemorySpace>& rest,

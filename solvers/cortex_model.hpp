@@ -191,7 +191,7 @@ class CortexModel {
   // first); needs the bond term.
   void node_fields(const NodeFields<Mem>& out) const {
     if (!bonds_) throw std::logic_error("node_fields() needs the FENE+POW bond term");
-    compute_node_fields(space_, mesh_, geo_, *bonds_, bond_params_, force_, out);
+    compute_node_fields(space_, mesh_, geo_, *bonds_, bond_params_.table(), force_, out);
   }
   // The state a step starts from: positions and the last velocity (the warm start of the next solve). The
   // rest states, parameters and external forces are not saved: they come from the scene.
@@ -254,7 +254,7 @@ class CortexModel {
     const auto bond = mesh_.bond;
     const auto rest = bonds_->rest_length;
     const auto bond_cell = mesh_.bond_cell;
-    const auto table = bond_params_;
+    const auto table = bond_params_.table();
     double m = 0;
     Kokkos::parallel_reduce(
         "dcm::model::max_bond_extension", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_bonds),
@@ -275,7 +275,7 @@ class CortexModel {
     const auto bond = mesh_.bond;
     const auto rest = bonds_->rest_length;
     const auto bond_cell = mesh_.bond_cell;
-    const auto table = bond_params_;
+    const auto table = bond_params_.table();
     segmented_max(
         "dcm::model::cell_max_bond_extension", space_, mesh_.bond_sums,
         KOKKOS_LAMBDA(const int b) {
@@ -308,18 +308,19 @@ class CortexModel {
     Kokkos::deep_copy(space_, force_, 0.0);
     if (bonds_) {
       Kokkos::deep_copy(space_, overstretched_, -1);
-      add_fene_pow_forces(space_, mesh_, *bonds_, bond_params_, force_, overstretched_);
+      add_fene_pow_forces(space_, mesh_, *bonds_, bond_params_.table(), force_, overstretched_);
       int bad = -1;
       Kokkos::deep_copy(bad, overstretched_);
       if (bad >= 0) throw NumericalError(describe_overstretch(bad));
     }
-    if (hinges_) add_bending_forces(space_, mesh_, *hinges_, k_b_, force_);
-    if (area_) add_area_forces(space_, mesh_, geo_, *area_, k_area_local_, k_area_global_, force_);
-    if (volume_) add_volume_forces(space_, mesh_, geo_, *volume_, k_volume_, force_);
+    if (hinges_) add_bending_forces(space_, mesh_, *hinges_, k_b_.table(), force_);
+    if (area_)
+      add_area_forces(space_, mesh_, geo_, *area_, k_area_local_.table(), k_area_global_.table(), force_);
+    if (volume_) add_volume_forces(space_, mesh_, geo_, *volume_, k_volume_.table(), force_);
     add_external_forces(space_, external_, force_);
     if (gravity_) add_external_forces(space_, *gravity_, force_);
     if (contact_) {
-      compute_plane_contact(space_, mesh_, geo_, params_.plane, contact_params_, *contact_);
+      compute_plane_contact(space_, mesh_, geo_, params_.plane, contact_params_.table(), *contact_);
       add_plane_contact_forces(space_, mesh_, params_.plane, *contact_, force_);
     }
     const int bad_node = first_non_finite_node(space_, force_);
@@ -343,10 +344,11 @@ class CortexModel {
     if (per_cell) per_cell->assign(mesh_.n_cells, 0.0);
     double e = external_energy(space_, mesh_.node_sums, external_, mesh_.x, per_cell);
     if (gravity_) add(external_energy(space_, mesh_.node_sums, *gravity_, mesh_.x, out), e);
-    if (bonds_) add(fene_pow_energy(space_, mesh_, *bonds_, bond_params_, out), e);
-    if (hinges_) add(bending_energy(space_, mesh_, *hinges_, k_b_, out), e);
-    if (area_) add(area_energy(space_, mesh_, geo_, *area_, k_area_local_, k_area_global_, out), e);
-    if (volume_) add(volume_energy(space_, mesh_, geo_, *volume_, k_volume_, out), e);
+    if (bonds_) add(fene_pow_energy(space_, mesh_, *bonds_, bond_params_.table(), out), e);
+    if (hinges_) add(bending_energy(space_, mesh_, *hinges_, k_b_.table(), out), e);
+    if (area_)
+      add(area_energy(space_, mesh_, geo_, *area_, k_area_local_.table(), k_area_global_.table(), out), e);
+    if (volume_) add(volume_energy(space_, mesh_, geo_, *volume_, k_volume_.table(), out), e);
     return e;
   }
 
@@ -385,8 +387,8 @@ class CortexModel {
       const auto rest = bonds_->rest_length;
       const auto k_dt = friction_.bond_stiffness_dt;
       const auto bond_cell = mesh_.bond_cell;
-      const auto table = bond_params_;
-      const auto step = dt_;
+      const auto table = bond_params_.table();
+      const auto step = dt_.table();
       Kokkos::parallel_for(
           "dcm::model::implicit_bonds", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_bonds),
           KOKKOS_LAMBDA(const int b) {
@@ -401,8 +403,8 @@ class CortexModel {
     update_friction(space_, mesh_, friction_);
     const bool implicit_tension = dt > 0 && tension_stiffness_.has_value();
     if (implicit_tension)
-      update_tension_stiffness(space_, mesh_, geo_, *area_, k_area_local_, k_area_global_, dt_,
-                               *tension_stiffness_);
+      update_tension_stiffness(space_, mesh_, geo_, *area_, k_area_local_.table(), k_area_global_.table(),
+                               dt_.table(), *tension_stiffness_);
     // The multigrid's fine level holds Γ, the implicit bonds and the implicit tension (same sparsity).
     if (multigrid_) {
       try {
@@ -419,8 +421,8 @@ class CortexModel {
       update_bending_stiffness(k_b_.host, dt_cells, *bending_stiffness_);  // ∇θ from compute_forces()
     if (implicit)
       update_global_stiffness(space_, mesh_, geo_, area_ ? area_->cell_area : volume_->cell_volume,
-                              volume_ ? volume_->cell_volume : area_->cell_area, k_area_global_, k_volume_,
-                              dt_, *global_);
+                              volume_ ? volume_->cell_volume : area_->cell_area, k_area_global_.table(),
+                              k_volume_.table(), dt_.table(), *global_);
     if (params_.dashpot == 0 && params_.dashpot_transverse == 0 && !friction_.substrate && !implicit &&
         !implicit_bending && !implicit_bonds && !implicit_tension) {
       apply_block_jacobi(space_, friction_, force_, velocity_);  // exact: Γ is block-diagonal (a frozen
@@ -568,18 +570,21 @@ class CortexModel {
     };
     std::string t;
     if (bonds_ && (t = check("FENE+POW bonds", [&] {
-                     add_fene_pow_forces(space_, mesh_, *bonds_, bond_params_, scratch, overstretched_);
+                     add_fene_pow_forces(space_, mesh_, *bonds_, bond_params_.table(), scratch,
+                                         overstretched_);
                    })) != "")
       return t;
-    if (hinges_ &&
-        (t = check("bending", [&] { add_bending_forces(space_, mesh_, *hinges_, k_b_, scratch); })) != "")
+    if (hinges_ && (t = check("bending", [&] {
+                      add_bending_forces(space_, mesh_, *hinges_, k_b_.table(), scratch);
+                    })) != "")
       return t;
     if (area_ && (t = check("area constraints", [&] {
-                    add_area_forces(space_, mesh_, geo_, *area_, k_area_local_, k_area_global_, scratch);
+                    add_area_forces(space_, mesh_, geo_, *area_, k_area_local_.table(),
+                                    k_area_global_.table(), scratch);
                   })) != "")
       return t;
     if (volume_ && (t = check("volume constraint", [&] {
-                      add_volume_forces(space_, mesh_, geo_, *volume_, k_volume_, scratch);
+                      add_volume_forces(space_, mesh_, geo_, *volume_, k_volume_.table(), scratch);
                     })) != "")
       return t;
     if (contact_ && (t = check("plane contact", [&] {

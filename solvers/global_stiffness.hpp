@@ -37,7 +37,7 @@ struct GlobalStiffness {
 
 // Gradients ∇A (Σ_t ½ n_t × (x_k − x_j)) and ∇V (Σ_t A_t n_t / 3) at every node for the current geometry,
 // and the coefficients Δt k / X*. rest_area, rest_volume: the cells' rest values.
-// k_d, k_v: one value each or PerCell tables (core/cell_params.hpp).
+// k_d, k_v: one value each or CellTables (PerCell::table(), core/cell_params.hpp).
 template <class ExecutionSpace, class MemorySpace, class KD, class KV, class DT>
 void update_global_stiffness(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                              const GeometryBuffers<MemorySpace>& geo,

@@ -31,7 +31,7 @@ struct TensionStiffness {
 };
 
 // Caches ê and n_t for the current geometry (update_geometry() first) and step dt.
-// k_a, k_d: one value each or PerCell tables (core/cell_params.hpp).
+// k_a, k_d: one value each or CellTables (PerCell::table(), core/cell_params.hpp).
 template <class ExecutionSpace, class MemorySpace, class KA, class KD, class DT>
 void update_tension_stiffness(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                               const GeometryBuffers<MemorySpace>& geo, const AreaRest<MemorySpace>& rest,

@@ -277,15 +277,23 @@ std::string batch_difference(const Member& a, const Member& b) {
 using Model = CortexModel<Exec>;
 using Stepper = TimeStepper<Exec>;
 
-void write_frame(Member& m, Model& model, NodeFields<Exec::memory_space>& fields, double t) {
+// Positions and per-node fields of every cell on the host, once for all members that write a frame now.
+struct FrameData {
+  std::vector<double> x, tension, stretch, normal_force, normal_pressure;
+};
+FrameData frame_data(Model& model, NodeFields<Exec::memory_space>& fields) {
   model.node_fields(fields);
-  const auto slice = [&](const Kokkos::View<double*, Kokkos::LayoutRight, Exec::memory_space>& v) {
-    const auto all = to_host_vector(v);
-    return std::vector<double>(all.begin() + m.first_node, all.begin() + m.first_node + m.n);
+  return {to_host_vector(model.positions()), to_host_vector(fields.tension), to_host_vector(fields.stretch),
+          to_host_vector(fields.normal_force), to_host_vector(fields.normal_pressure)};
+}
+
+void write_frame(Member& m, const FrameData& d, double t) {
+  const auto slice = [&](const std::vector<double>& all, int per_node) {
+    return std::vector<double>(all.begin() + per_node * m.first_node,
+                               all.begin() + per_node * (m.first_node + m.n));
   };
-  const auto x = model.cell_slice(model.positions(), m.cell);
-  const auto tension = slice(fields.tension), stretch = slice(fields.stretch);
-  const auto fn = slice(fields.normal_force), pn = slice(fields.normal_pressure);
+  const auto x = slice(d.x, 3), tension = slice(d.tension, 1), stretch = slice(d.stretch, 1);
+  const auto fn = slice(d.normal_force, 1), pn = slice(d.normal_pressure, 1);
   m.h5->write_frame(t, x.data(),
                     {{"cortex_tension_J_per_m2", 1, tension.data()},
                      {"stretch", 1, stretch.data()},
@@ -336,7 +344,7 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   write_checkpoint_now(m, model, stepper, wall_now);
   model.compute_forces();
   const double t = stepper.time(m.cell);
-  write_frame(m, model, fields, t);
+  write_frame(m, frame_data(model, fields), t);
   m.csv.close();
   std::rename(m.csv_tmp.c_str(), (m.out_dir + "/series.csv").c_str());
   m.h5->close();
@@ -519,6 +527,7 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
     try {
       rep = stepper.step(model, ms.front().cg, cap, [&](const std::vector<double>& h_planned) {
         bool any_sample = false;
+        std::optional<FrameData> frame;  // computed once, for every member that writes a frame now
         for (Member& m : ms) {
           m.sample = false;
           if (m.done || cap[m.cell] == 0) continue;
@@ -527,7 +536,8 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
           const auto next_figure = static_cast<std::size_t>(p.next_figure);
           if (t >= p.next_frame - 1e-12 ||
               (next_figure < kFigureTimes.size() && t >= kFigureTimes[next_figure] - 1e-12)) {
-            write_frame(m, model, fields, t);
+            if (!frame) frame = frame_data(model, fields);
+            write_frame(m, *frame, t);
             while (p.next_frame <= t + 1e-12) p.next_frame += m.frame_every;
             std::size_t f = next_figure;
             while (f < kFigureTimes.size() && kFigureTimes[f] <= t + 1e-12) ++f;
@@ -567,6 +577,7 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
         any_row ? to_host_vector(model.geometry().cell_area) : std::vector<double>();
     const std::vector<double> cell_volume =
         any_row ? to_host_vector(model.geometry().cell_volume) : std::vector<double>();
+    const std::vector<double> x_all = any_row ? to_host_vector(model.positions()) : std::vector<double>();
     for (Member& m : ms) {
       if (m.done || cap[m.cell] == 0) continue;
       const StepReport& r = rep[m.cell];
@@ -598,9 +609,8 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
                                             (ms.size() > 1 ? " of member " + m.out_dir : std::string()));
         }
         const double r_cc = std::sqrt(area_c / kPi);
-        const auto xh = model.cell_slice(model.positions(), m.cell);
         double ztop = -INFINITY;
-        for (int i = 0; i < m.n; ++i) ztop = std::max(ztop, xh[3 * i + 2]);
+        for (int i = m.first_node; i < m.first_node + m.n; ++i) ztop = std::max(ztop, x_all[3 * i + 2]);
         char line[512];
         std::snprintf(line, sizeof line,
                       "%.9g,%.9g,%.9g,%.9g,%.9g,%d,%.6g,%.9g,%.9g,%.12g,%.6g,%.6g,%.6g,%.6g\n", t + h, r_cc,
