@@ -193,14 +193,9 @@ class CortexModel {
     if (!bonds_) throw std::logic_error("node_fields() needs the FENE+POW bond term");
     compute_node_fields(space_, mesh_, geo_, *bonds_, bond_params_.table(), force_, out);
   }
-  // The state a step starts from: positions and the last velocity (the warm start of the next solve). The
-  // rest states, parameters and external forces are not saved: they come from the scene.
-  void save_state(Checkpoint& c) const {
-    c.put("model.x", to_host_vector(mesh_.x));
-    c.put("model.v", to_host_vector(velocity_));
-  }
-  // The same for one cell of a batch, under the same names: a batch member's checkpoint is the checkpoint
-  // of the one-cell run.
+  // The state a step of a cell starts from: its positions and last velocity (the warm start of the next
+  // solve). The rest states, parameters and external forces are not saved: they come from the scene. A
+  // batch member's checkpoint is the checkpoint of its one-cell run.
   void save_cell_state(Checkpoint& c, int cell) const {
     c.put("model.x", cell_slice(mesh_.x, cell));
     c.put("model.v", cell_slice(velocity_, cell));
@@ -221,12 +216,6 @@ class CortexModel {
     for (int i = b; i < e; ++i)
       for (int d = 0; d < 3; ++d) all(i, d) = values[3 * (i - b) + d];
     Kokkos::deep_copy(v, all);
-  }
-  void restore_state(const Checkpoint& c) {
-    const std::size_t size = 3 * static_cast<std::size_t>(mesh_.n_nodes);
-    from_host_vector(mesh_.x, c.array("model.x", size));
-    from_host_vector(velocity_, c.array("model.v", size));
-    update_geometry(space_, mesh_, geo_, params_.h_min);
   }
   // One cell's state from a checkpoint of it (save_cell_state()).
   void restore_cell_state(const Checkpoint& c, int cell) {

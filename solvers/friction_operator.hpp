@@ -61,6 +61,7 @@ struct FrictionOperator {
   // fills them from the scalars above, or from cell_rows when set (a batch of cells with different
   // constants: core/cell_params.hpp); Γ has no coupling between cells either way.
   View<double* [5]> cell_coef;
+  typename View<double* [5]>::HostMirror cell_coef_host;  // staging, kept (no allocation per step)
   std::vector<std::array<double, 5>> cell_rows;
 
   FrictionOperator() = default;
@@ -71,7 +72,8 @@ struct FrictionOperator {
         bond_dir(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::friction::bond_dir"), mesh.n_bonds),
         block_inverse(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::friction::block_inverse"),
                       mesh.n_nodes),
-        cell_coef("dcm::friction::cell_coef", mesh.n_cells) {}
+        cell_coef("dcm::friction::cell_coef", mesh.n_cells),
+        cell_coef_host(Kokkos::create_mirror_view(cell_coef)) {}
 };
 
 enum FrictionCoef : int { kDashpot = 0, kDashpotTransverse = 1, kGammaN = 2, kGammaT = 3, kPin = 4 };
@@ -79,7 +81,7 @@ enum FrictionCoef : int { kDashpot = 0, kDashpotTransverse = 1, kGammaN = 2, kGa
 // Fills op.cell_coef (from cell_rows, or the scalars for every cell).
 template <class MemorySpace>
 void sync_friction_coefficients(const FrictionOperator<MemorySpace>& op) {
-  auto h = Kokkos::create_mirror_view(op.cell_coef);
+  const auto h = op.cell_coef_host;
   for (std::size_t c = 0; c < h.extent(0); ++c) {
     const std::array<double, 5> uniform{op.dashpot, op.dashpot_transverse, op.gamma_n, op.gamma_t,
                                         op.pin_friction};

@@ -43,7 +43,7 @@ void probe(const std::string& path, const std::vector<std::string>& sets, bool a
   scene.validate();
   dcm::CortexModel<Exec> model(Exec(), {dcm::HostCell(dcm::cell_mesh_from_scene(scene))},
                                dcm::mechanics_from_scene(scene));
-  model.restore_state(c);
+  model.restore_cell_state(c, 0);
   model.compute_forces();
   const auto x = host(model.positions());
   const auto tri = host(model.mesh().tri);
