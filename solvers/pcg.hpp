@@ -140,7 +140,7 @@ CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& pr
   const auto alpha = w.alpha, beta = w.beta;
   const auto& sums = w.sums;
   auto& res = w.segment_results;
-  std::vector<double> bb(n_seg), rr(n_seg), rz(n_seg), pq(n_seg), rz_new(n_seg), tol(n_seg);
+  std::vector<double> bb(n_seg), rz(n_seg), pq(n_seg), rz_new(n_seg), tol(n_seg);
   std::vector<char> active(n_seg, 0);
   int n_active = 0;
   const auto publish = [&] {  // w.active = the segments still iterating
