@@ -164,6 +164,11 @@ std::vector<ParamSpec> make_schema() {
           "solver.preconditioner", "multigrid", {"block_jacobi", "multigrid"},
           "preconditioner of Γ: multigrid (V-cycle on the icosphere hierarchy; block_jacobi where a mesh "
           "has none) or block_jacobi"),
+      int_key("solver.mg_sweeps", "2", 1, 16,
+              "multigrid: damped block-Jacobi sweeps before and after each coarse correction (ν)"),
+      real_key("solver.mg_damping", "0.6", 0, 0.66, kExcl, "",
+               "multigrid: the smoother's damping ω (ω λ_max(D⁻¹A) < 2 keeps the V-cycle positive definite, "
+               "and λ_max ≤ 3 on the finest level)"),
       bool_key(
           "solver.implicit_bending", "true",
           "bending's Gauss–Newton stiffness in the velocity solve: stable at the paper's Δt on fine meshes"),

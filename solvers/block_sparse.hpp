@@ -50,6 +50,27 @@ void block_csr_residual(const ExecutionSpace& space, const BlockCsr<MemorySpace>
       });
 }
 
+// out = A x; one gather per row. The velocity solve's operator where the multigrid's level 0 holds it
+// (solvers/cortex_model.hpp). active (optional): only the rows of these cells.
+template <class ExecutionSpace, class MemorySpace, class Vector>
+void block_csr_multiply(const ExecutionSpace& space, const BlockCsr<MemorySpace>& a, const Vector& x,
+                        const Vector& out, const CellFlags<MemorySpace>& active = {}) {
+  const auto row_cell = a.row_cell;
+  const auto off = a.row_offsets;
+  const auto cols = a.cols;
+  const auto val = a.values;
+  Kokkos::parallel_for(
+      "dcm::bsr::multiply", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows),
+      KOKKOS_LAMBDA(const int i) {
+        if (skipped(active, row_cell(i))) return;
+        Real3 acc{0, 0, 0};
+        for (int s = off(i); s < off(i + 1); ++s)
+          acc +=
+              sym3_times(val(s, 0), val(s, 1), val(s, 2), val(s, 3), val(s, 4), val(s, 5), load3(x, cols(s)));
+        store3(out, i, acc);
+      });
+}
+
 // Inverts every diagonal block (the block-Jacobi smoother's D⁻¹).
 template <class ExecutionSpace, class MemorySpace>
 void block_csr_invert_diagonal(const ExecutionSpace& space, const BlockCsr<MemorySpace>& a) {

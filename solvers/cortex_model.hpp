@@ -49,6 +49,7 @@ struct MechanicsParams {
   double viscosity = 0.8e-3;      // η (Pa·s), Stokes drag 6πηr/N per node
   double h_min = 1e4;             // 1/m, triangle curvature clamp
   bool multigrid = false;         // V-cycle preconditioner (where the mesh has an icosphere hierarchy)
+  MultigridSettings mg;           // its smoother: sweeps and damping
   bool implicit_bonds = false;    // the bonds' axial stiffness Δt k'(d) in the solve (stiff FENE near d_max)
   bool implicit_bending =
       false;  // bending's Gauss-Newton stiffness in the solve (solvers/bending_stiffness.hpp)
@@ -83,7 +84,8 @@ inline std::string batch_mismatch(const MechanicsParams& a, const MechanicsParam
       {"dashpots on/off",
        on(a.dashpot) != on(b.dashpot) || on(a.dashpot_transverse) != on(b.dashpot_transverse)},
       {"the curvature clamp h_min", a.h_min != b.h_min},
-      {"the preconditioner (multigrid)", a.multigrid != b.multigrid},
+      {"the preconditioner (multigrid, its sweeps and damping)",
+       a.multigrid != b.multigrid || a.mg.sweeps != b.mg.sweeps || a.mg.damping != b.mg.damping},
       {"the implicit terms", a.implicit_bonds != b.implicit_bonds ||
                                  a.implicit_bending != b.implicit_bending ||
                                  a.implicit_tension != b.implicit_tension},
@@ -167,7 +169,7 @@ class CortexModel {
     for (const MechanicsParams& q : cell_params_)
       friction_.cell_rows.push_back({q.dashpot, q.dashpot_transverse, q.gamma_n, q.gamma_t, q.pin_friction});
     if (p.multigrid && (p.dashpot > 0 || p.dashpot_transverse > 0)) {
-      multigrid_ = make_multigrid(cells, mesh_);
+      multigrid_ = make_multigrid(cells, mesh_, p.mg);
       if (!multigrid_->available) multigrid_.reset();  // no hierarchy: block-Jacobi
     }
   }
@@ -389,7 +391,7 @@ class CortexModel {
     } else {
       friction_.bond_stiffness_dt = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
     }
-    update_friction(space_, mesh_, friction_);
+    update_friction(space_, mesh_, friction_, !multigrid_.has_value());  // the multigrid inverts its own
     const bool implicit_tension = dt > 0 && tension_stiffness_.has_value();
     if (implicit_tension)
       update_tension_stiffness(space_, mesh_, geo_, *area_, k_area_local_.table(), k_area_global_.table(),
@@ -426,11 +428,16 @@ class CortexModel {
         // Only the cells still iterating (a batch: the others have converged or are not stepping; one cell:
         // no mask, no per-row check).
         [&](const Vector& in, const Vector& out) {
-          apply_friction(space_, mesh_, friction_, in, out, active);
+          if (multigrid_) {  // its level 0 holds Γ, the implicit bonds and tension: one block product
+            block_csr_multiply(space_, multigrid_->levels[0].a, in, out, active);
+          } else {
+            apply_friction(space_, mesh_, friction_, in, out, active);
+            if (implicit_tension)
+              apply_tension_stiffness(space_, mesh_, *tension_stiffness_, in, out, active);
+          }
           if (implicit) apply_global_stiffness(space_, mesh_, *global_, in, out, active);
           if (implicit_bending)
             apply_bending_stiffness(space_, mesh_, *hinges_, *bending_stiffness_, in, out, active);
-          if (implicit_tension) apply_tension_stiffness(space_, mesh_, *tension_stiffness_, in, out, active);
         },
         [&](const Vector& in, const Vector& out) {
           if (multigrid_)

@@ -226,10 +226,12 @@ SubstrateBlocks<MemorySpace> substrate_blocks(const MeshBuffers<MemorySpace>& me
   return s;
 }
 
-// Caches n̂_b and the inverted diagonal blocks ζ_i I + Σ_b c n̂_b n̂_bᵀ for the current positions.
+// Caches n̂_b and the inverted diagonal blocks ζ_i I + Σ_b c n̂_b n̂_bᵀ for the current positions
+// (block_inverse = false: n̂_b only, for a caller that preconditions with the multigrid, which inverts its
+// own diagonal blocks).
 template <class ExecutionSpace, class MemorySpace>
 void update_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                     const FrictionOperator<MemorySpace>& op) {
+                     const FrictionOperator<MemorySpace>& op, bool block_inverse = true) {
   sync_friction_coefficients(op);
   const auto x = mesh.x;
   const auto bond = mesh.bond;
@@ -241,6 +243,7 @@ void update_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>
         const double len = norm(d);
         store3(dir, b, len > 0 ? (1.0 / len) * d : Real3{0, 0, 0});
       });
+  if (!block_inverse) return;
   const auto offsets = mesh.node_bond_offsets;
   const auto bonds = mesh.node_bonds;
   const auto drag = op.node_drag;

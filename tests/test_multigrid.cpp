@@ -234,6 +234,32 @@ TEST(Multigrid, WithSubstrateFrictionPcgAgreesWithEigen) {
   EXPECT_LT(r.iterations, rb.iterations);
 }
 
+// The velocity solve applies Γ as the product with the multigrid's level 0 (solvers/cortex_model.hpp):
+// the same operator as the matrix-free apply_friction, with consistent and with lumped substrate friction
+// and the implicit bond stiffness, to rounding.
+TEST(Multigrid, FineLevelProductIsTheFrictionOperator) {
+  for (const bool lumped : {false, true}) {
+    Preconditioned s({3});
+    s.enable_random_substrate(9, lumped);
+    s.op.bond_stiffness_dt = Kokkos::View<double*, Kokkos::LayoutRight, Mem>("k", s.mesh.n_bonds);
+    Kokkos::deep_copy(s.op.bond_stiffness_dt, 2.5e-7);
+    update_friction(Exec(), s.mesh, s.op);
+    update_multigrid(Exec(), s.mesh, s.op, s.mg);
+    const Vector v = s.random_vector(17, 1e-6);
+    Vector matrix_free("matrix_free", s.mesh.n_nodes), assembled("assembled", s.mesh.n_nodes);
+    apply_friction(Exec(), s.mesh, s.op, v, matrix_free);
+    block_csr_multiply(Exec(), s.mg.levels[0].a, v, assembled);
+    const auto a = to_host_vector(matrix_free), b = to_host_vector(assembled);
+    double diff = 0, norm = 0;
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      diff += (a[k] - b[k]) * (a[k] - b[k]);
+      norm += a[k] * a[k];
+    }
+    ASSERT_GT(norm, 0.0);
+    EXPECT_LT(std::sqrt(diff), 1e-13 * std::sqrt(norm)) << (lumped ? "lumped" : "consistent");
+  }
+}
+
 TEST(Multigrid, IterationsWellBelowBlockJacobi) {
   for (int k = 2; k <= 4; ++k) {
     const Preconditioned s({k});

@@ -27,6 +27,8 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
   p.viscosity = scene.get_real("fluid.eta_Pa_s");
   p.h_min = scene.get_real("geometry.h_min_per_m");
   p.multigrid = scene.get_string("solver.preconditioner") == "multigrid";
+  p.mg.sweeps = static_cast<int>(scene.get_int("solver.mg_sweeps"));
+  p.mg.damping = scene.get_real("solver.mg_damping");
   p.implicit_bending = scene.get_bool("solver.implicit_bending");
   p.implicit_bonds = scene.get_bool("solver.implicit_bonds");
   p.implicit_tension = scene.get_bool("solver.implicit_tension");
