@@ -134,11 +134,12 @@ std::vector<ParamSpec> make_schema() {
           "contact.friction_zone", "adhesive", {"adhesive", "contact"},
           "where the substrate friction acts on a triangle: adhesive = within r < max(a, c), the contact "
           "and adhesive zone (dcm); contact = within the contact radius a only (the paper's A^C)"),
-      string_key("contact.friction_weights", "lumped", {"lumped", "consistent"},
-                 "how a triangle's substrate friction reaches its nodes: lumped = w_i Γ_t on each node's own "
-                 "velocity, w_i the node's share of the contact force (dcm's default: damps every node in "
-                 "contact, CG converges in a few iterations); consistent = β_i β_j Γ_t on the contact "
-                 "point's velocity"),
+      string_key("contact.friction_weights", "area", {"area", "lumped", "consistent"},
+                 "how a triangle's substrate friction reaches its nodes: area = w_i Γ_t on each node's own "
+                 "velocity, w_i the barycentric coordinates of the friction area's centroid (dcm's default "
+                 "since session 8: no jump when a triangle's net load passes through zero); lumped = the "
+                 "same with w_i the node's share of the contact force (the default of sessions 3-7); "
+                 "consistent = β_i β_j Γ_t on the contact point's velocity"),
       real_key(
           "contact.pin_friction_N_s_per_m", "0", 0, 1, kIncl, "N·s/m",
           "extra friction on nodes whose triangles all lie fully in the contact (the paper's pinning; 0: "

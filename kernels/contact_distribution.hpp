@@ -88,6 +88,28 @@ KOKKOS_INLINE_FUNCTION void clamped_barycentric(const double u[3], const double 
 
 }  // namespace contact_detail
 
+// Barycentric coordinates in the triangle (x0, x1, x2), projected along n, of the point P (or of the nearest
+// point of the projected triangle): >= 0, sum 1. A degenerate projection gives 1/3 each.
+KOKKOS_INLINE_FUNCTION void projected_barycentric(Real3 x0, Real3 x1, Real3 x2, Real3 P, Real3 n,
+                                                  double lam[3]) {
+  Real3 e1, e2;
+  contact_detail::plane_frame((1.0 / norm(n)) * n, e1, e2);
+  const Real3 xs[3] = {x0, x1, x2};
+  double u[3], v[3];
+  for (int k = 0; k < 3; ++k) {
+    u[k] = dot(xs[k] - x0, e1);
+    v[k] = dot(xs[k] - x0, e2);
+  }
+  const double d = (u[1] - u[0]) * (v[2] - v[0]) - (u[2] - u[0]) * (v[1] - v[0]);
+  const double scale = (u[1] - u[0]) * (u[1] - u[0]) + (v[1] - v[0]) * (v[1] - v[0]) +
+                       (u[2] - u[0]) * (u[2] - u[0]) + (v[2] - v[0]) * (v[2] - v[0]);
+  if (!(math::fabs(d) > kProjectedTriangleDegenerateRatio * scale)) {
+    lam[0] = lam[1] = lam[2] = 1.0 / 3.0;
+    return;
+  }
+  contact_detail::clamped_barycentric(u, v, d, dot(P - x0, e1), dot(P - x0, e2), lam);
+}
+
 // Eq. 19: the normal load Fn n and the moment M about C (M perpendicular to n; a component along n is
 // ignored) of a triangle (x0, x1, x2), distributed to its nodes as f_i n; n need not be normalised.
 KOKKOS_INLINE_FUNCTION NodeLoads distribute_normal_load(Real3 x0, Real3 x1, Real3 x2, Real3 C, Real3 n,

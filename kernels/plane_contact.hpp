@@ -46,6 +46,10 @@ struct ContactBuffers {
   using View = Kokkos::View<T, Kokkos::LayoutRight, MemorySpace>;
   View<double* [3]> tri_node_load;  // normal force on each corner's node (N), along the plane normal
   View<double* [3]> tri_beta;       // friction weights β of each corner (Σ = 1)
+  // Barycentric coordinates of the centroid of the area the substrate friction acts on (Σ = 1, ≥ 0): the
+  // "area" friction weights (contact.friction_weights), which follow where the contact is, not where the net
+  // load is (β jumps between corners when a triangle's net load passes through zero).
+  View<double* [3]> tri_area_weight;
   View<double*> tri_contact_area;   // A^C_t, the part of the triangle inside the contact radius a (m²)
   View<double*> tri_friction_area;  // the area the substrate friction acts on (m²): A^C_t or the zone r < c
   View<double*> tri_load;           // F_t · n (N), repulsive positive
@@ -55,6 +59,7 @@ struct ContactBuffers {
   explicit ContactBuffers(int n_tris)
       : tri_node_load("dcm::contact::tri_node_load", n_tris),
         tri_beta("dcm::contact::tri_beta", n_tris),
+        tri_area_weight("dcm::contact::tri_area_weight", n_tris),
         tri_contact_area("dcm::contact::tri_contact_area", n_tris),
         tri_friction_area("dcm::contact::tri_friction_area", n_tris),
         tri_load("dcm::contact::tri_load", n_tris),
@@ -117,6 +122,7 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
   const auto radius = geo.tri_sphere_radius;
   const auto node_load = out.tri_node_load;
   const auto beta = out.tri_beta;
+  const auto area_weight = out.tri_area_weight;
   const auto contact_area = out.tri_contact_area;
   const auto friction_area = out.tri_friction_area;
   const auto load = out.tri_load;
@@ -130,6 +136,7 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
         for (int k = 0; k < 3; ++k) {
           node_load(t, k) = 0;
           beta(t, k) = 0;
+          area_weight(t, k) = 0;
         }
         contact_area(t) = 0;
         friction_area(t) = 0;
@@ -155,6 +162,7 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
         const double area_t = tri_area(t);
         const double area_q = prm.projected_area ? 0.5 * math::fabs(dot(cross(x1 - x0, x2 - x0), n)) : area_t;
         double Fn = 0, a_contact = 0, a_zone = 0;
+        double lam_friction[3] = {-1, 0, 0};  // the friction area's centroid in barycentric coordinates
         Real3 M{0, 0, 0}, C_apply = C;
         const int nq = prm.quadrature_points;
         if (nq == 0) {  // exact in r, Gauss in θ (kernels/polar_contact_integral.hpp); no regimes needed
@@ -167,21 +175,36 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
           M = pi.m1 * e1 + pi.m2 * e2;
           a_contact = pi.contact_area;
           a_zone = pi.zone_area;
+          const double fa = prm.friction_on_adhesive_zone ? a_zone : a_contact;
+          if (fa > 1e-9 * area_q) {  // (a sliver's moments are rounding noise; its friction is negligible)
+            const double mx = prm.friction_on_adhesive_zone ? pi.zone_x : pi.contact_x,
+                         my = prm.friction_on_adhesive_zone ? pi.zone_y : pi.contact_y;
+            projected_barycentric(x0, x1, x2, C + (mx / fa) * e1 + (my / fa) * e2, n, lam_friction);
+          }
           regime(t) = st.a > 0 ? kQuadrature : kGap;
         } else if (kMdPi * outer * outer * nq >= 2.0 * area_t) {  // eq. 18, regime 1: quadrature (eqs. 16–17)
           integrate_pressure(
               x0, x1, x2, C, n, area_q, nq, [&](Real3 r) { return md_pressure(st, norm(r)); }, Fn, M);
-          double inside = 0, in_zone = 0;
+          double inside = 0, in_zone = 0, moment[3] = {0, 0, 0};
           for (int q = 0; q < nq; ++q) {
             double l1, l2, l3, w;
             quadrature_point(nq, q, l1, l2, l3, w);
             const Real3 rel = l1 * x0 + l2 * x1 + l3 * x2 - C;
             const Real3 r = rel - dot(rel, n) * n;
-            if (norm2(r) < st.a * st.a) inside += w;
-            if (norm2(r) < outer * outer) in_zone += w;
+            const bool in_a = norm2(r) < st.a * st.a, in_c = norm2(r) < outer * outer;
+            if (in_a) inside += w;
+            if (in_c) in_zone += w;
+            if (prm.friction_on_adhesive_zone ? in_c : in_a) {
+              moment[0] += w * l1;
+              moment[1] += w * l2;
+              moment[2] += w * l3;
+            }
           }
           a_contact = inside * area_q;
           a_zone = in_zone * area_q;
+          const double fw = prm.friction_on_adhesive_zone ? in_zone : inside;
+          if (fw > 1e-9)
+            for (int k = 0; k < 3; ++k) lam_friction[k] = moment[k] / fw;
           regime(t) = st.a > 0 ? kQuadrature : kGap;
         } else {  // regime 2: the disc's share of the net load, at C or the triangle's nearest point
           const Real3 q0 = x0 - dot(x0 - C, n) * n, q1 = x1 - dot(x1 - C, n) * n,
@@ -191,12 +214,14 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
           a_contact = fraction * kMdPi * st.a * st.a;
           a_zone = fraction * kMdPi * outer * outer;
           C_apply = nearest_point_in_triangle(q0, q1, q2, C, n);
+          projected_barycentric(x0, x1, x2, C_apply, n, lam_friction);
           regime(t) = st.a > 0 ? kSmallDisc : kGap;
         }
         const NodeLoads nl = distribute_normal_load(x0, x1, x2, C_apply, n, Fn, M);  // eq. 19
         for (int k = 0; k < 3; ++k) {
           node_load(t, k) = nl.f[k];
           beta(t, k) = nl.beta[k];
+          area_weight(t, k) = lam_friction[0] >= 0 ? lam_friction[k] : 1.0 / 3.0;
         }
         load(t) = Fn;
         contact_area(t) =

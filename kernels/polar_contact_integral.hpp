@@ -118,6 +118,9 @@ struct PolarIntegral {
   double m1 = 0, m2 = 0;    // moment about C in the basis (e1, e2) of the plane (N·m)
   double contact_area = 0;  // area of the triangle within r < a (m²)
   double zone_area = 0;     // area of the triangle within r < max(a, c), contact and adhesive zone (m²)
+  // First moments about C, in the basis (e1, e2), of those two areas (m³): their centroids are C +
+  // (x e1 + y e2) / area.
+  double contact_x = 0, contact_y = 0, zone_x = 0, zone_y = 0;
 };
 
 namespace detail {
@@ -176,6 +179,11 @@ KOKKOS_INLINE_FUNCTION void polar_sector(const MdRadial& st, double px, double p
       out.contact_area += dtheta * 0.5 * ra * ra;
       const double rz = math::min(rho, math::max(st.a, st.c));
       out.zone_area += dtheta * 0.5 * rz * rz;
+      const double ma = dtheta * ra * ra * ra / (3.0 * rho), mz = dtheta * rz * rz * rz / (3.0 * rho);
+      out.contact_x += ma * rx;  // ∫ r ê(θ) r dr dθ, ê = (rx, ry)/ρ
+      out.contact_y += ma * ry;
+      out.zone_x += mz * rx;
+      out.zone_y += mz * ry;
     }
   }
 }
@@ -201,6 +209,10 @@ KOKKOS_INLINE_FUNCTION PolarIntegral polar_contact_integral(const MdState& st, R
     out.m2 = -out.m2;
     out.contact_area = -out.contact_area;
     out.zone_area = -out.zone_area;
+    out.contact_x = -out.contact_x;
+    out.contact_y = -out.contact_y;
+    out.zone_x = -out.zone_x;
+    out.zone_y = -out.zone_y;
   }
   return out;
 }

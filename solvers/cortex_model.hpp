@@ -65,6 +65,7 @@ struct MechanicsParams {
   double pin_friction = 0;  // N·s/m on nodes fully in contact (the paper's pinning); 0: off
   bool lumped_friction =
       true;  // substrate friction w_i Γ_t per node (false: β_i β_j Γ_t), friction_operator.hpp
+  bool area_friction_weights = true;  // lumped: w_i from the friction area's centroid (false: the load's)
 };
 
 // Why cells with parameters a and b cannot share the buffers of one batch ("" if they can): what decides
@@ -101,7 +102,8 @@ inline std::string batch_mismatch(const MechanicsParams& a, const MechanicsParam
            a.contact.friction_on_adhesive_zone != b.contact.friction_on_adhesive_zone},
       {"substrate friction on/off", on(a.gamma_n) != on(b.gamma_n) || on(a.gamma_t) != on(b.gamma_t) ||
                                         on(a.pin_friction) != on(b.pin_friction)},
-      {"lumped substrate friction", a.lumped_friction != b.lumped_friction},
+      {"lumped substrate friction",
+       a.lumped_friction != b.lumped_friction || a.area_friction_weights != b.area_friction_weights},
   };
   for (const Switch& s : checks)
     if (s.differs) return std::string("they differ in ") + s.name;
@@ -164,7 +166,7 @@ class CortexModel {
       contact_ = ContactBuffers<Mem>(mesh_.n_tris);
       if (p.gamma_n > 0 || p.gamma_t > 0 || p.pin_friction > 0)
         enable_substrate_friction(friction_, *contact_, p.gamma_n, p.gamma_t, p.plane.normal, p.pin_friction,
-                                  p.lumped_friction);
+                                  p.lumped_friction, p.area_friction_weights);
     }
     for (const MechanicsParams& q : cell_params_)
       friction_.cell_rows.push_back({q.dashpot, q.dashpot_transverse, q.gamma_n, q.gamma_t, q.pin_friction});

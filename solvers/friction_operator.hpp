@@ -111,12 +111,14 @@ void enable_substrate_friction(FrictionOperator<MemorySpace>& op,
 
 // The same from the contact buffers of kernels/plane_contact.hpp; pin_friction > 0 also pins the nodes whose
 // triangles all lie fully in the contact (their regime, refreshed by the contact kernel each step).
+// area_weights (with lumped): each corner's share is its barycentric coordinate of the friction area's
+// centroid (ContactBuffers::tri_area_weight) instead of that of the centre of pressure (β).
 template <class MemorySpace>
 void enable_substrate_friction(FrictionOperator<MemorySpace>& op, const ContactBuffers<MemorySpace>& contact,
                                double gamma_n, double gamma_t, Real3 normal, double pin_friction = 0,
-                               bool lumped = false) {
-  enable_substrate_friction(op, contact.tri_beta, contact.tri_friction_area, gamma_n, gamma_t, normal,
-                            lumped);
+                               bool lumped = false, bool area_weights = false) {
+  enable_substrate_friction(op, lumped && area_weights ? contact.tri_area_weight : contact.tri_beta,
+                            contact.tri_friction_area, gamma_n, gamma_t, normal, lumped);
   op.pin_friction = pin_friction;
   op.tri_regime = contact.tri_regime;
 }

@@ -276,6 +276,51 @@ TEST(PlaneContact, PolarIntegralOfOneTriangleMatchesAFineReference) {
   }
 }
 
+// The first moments of the contact area (r < a) and of the zone (r < max(a, c)) in the exact polar
+// integration, against a fine subdivision of the same triangles (their centroids give the "area" friction
+// weights).
+void reference_area_moments(const MdState& st, Real3 p0, Real3 p1, Real3 p2, int level, double m[6]) {
+  if (level > 0) {
+    const Real3 m01 = 0.5 * (p0 + p1), m12 = 0.5 * (p1 + p2), m20 = 0.5 * (p2 + p0);
+    const Real3 tris[4][3] = {{p0, m01, m20}, {m01, p1, m12}, {m20, m12, p2}, {m01, m12, m20}};
+    for (const auto& t : tris) reference_area_moments(st, t[0], t[1], t[2], level - 1, m);
+    return;
+  }
+  const Real3 r = (1.0 / 3.0) * (p0 + p1 + p2);
+  const double area = 0.5 * norm(cross(p1 - p0, p2 - p0)), d = norm(r);
+  if (d < st.a) {
+    m[0] += area;
+    m[1] += area * r.x;
+    m[2] += area * r.y;
+  }
+  if (d < std::fmax(st.a, st.c)) {
+    m[3] += area;
+    m[4] += area * r.x;
+    m[5] += area * r.y;
+  }
+}
+
+TEST(PlaneContact, PolarAreaMomentsMatchAFineReference) {
+  const Real3 e1{1, 0, 0}, e2{0, 1, 0}, C{0, 0, 0};
+  const MdState st = md_state_from_radius(0.4e-6, kR, material_for_lambda(1.0));
+  const Real3 tris[3][3] = {{{0.3e-6, 0.1e-6, 0}, {0.5e-6, 0.05e-6, 0}, {0.42e-6, 0.3e-6, 0}},  // across a
+                            {{st.c - 0.1e-6, 0, 0}, {st.c + 0.1e-6, 0.02e-6, 0}, {st.c, 0.2e-6, 0}},
+                            {{-0.6e-6, -0.2e-6, 0}, {-0.2e-6, -0.5e-6, 0}, {-0.3e-6, 0.1e-6, 0}}};
+  for (const auto& t : tris) {
+    double m[6] = {0, 0, 0, 0, 0, 0};
+    reference_area_moments(st, t[0], t[1], t[2], 9, m);
+    const PolarIntegral pi = polar_contact_integral(st, t[0], t[1], t[2], C, e1, e2);
+    const double area = 0.5 * norm(cross(t[1] - t[0], t[2] - t[0])), len = 1e-6;
+    ASSERT_GT(m[3], 0.0);
+    EXPECT_NEAR(pi.contact_area, m[0], 2e-3 * area);
+    EXPECT_NEAR(pi.contact_x, m[1], 2e-3 * area * len);
+    EXPECT_NEAR(pi.contact_y, m[2], 2e-3 * area * len);
+    EXPECT_NEAR(pi.zone_area, m[3], 2e-3 * area);
+    EXPECT_NEAR(pi.zone_x, m[4], 2e-3 * area * len);
+    EXPECT_NEAR(pi.zone_y, m[5], 2e-3 * area * len);
+  }
+}
+
 // A rigid icosphere that can be moved along z without rebuilding anything.
 struct MovableSphere {
   MeshBuffers<Mem> mesh;
@@ -331,6 +376,62 @@ TEST(PlaneContact, LoadIsContinuousThroughOnsetAndTheEndOfTheGapBranch) {
       EXPECT_LT(worst, 0.01 * scale);
     }
   }
+}
+
+// The "area" friction weights (barycentric coordinates of the friction area's centroid) are weights (≥ 0,
+// Σ = 1), 1/3 each on a triangle wholly in the friction zone, and the friction they give each node, w_i A_t^f
+// γ, changes little with a small move, also where a triangle's net load passes through zero and the
+// load-share weights β jump between corners (the cause of the adaptive steps' rejection storms,
+// docs/model/spread.md). Swept in steps of h0/400 from δ = 2 h0 to 3 h0.
+TEST(PlaneContact, AreaFrictionWeightsAreContinuous) {
+  MovableSphere sphere(3, 0.3);
+  PlaneContactParams prm;
+  prm.material = md_material(kE, kNu, kW, 20e-9);
+  const double h0 = prm.material.h0;
+  std::vector<double> w_prev, b_prev, fa_prev;
+  double worst_w = 0, worst_beta = 0;
+  for (int i = 0; i <= 400; ++i) {
+    sphere.load_at(2 * h0 + i * h0 / 400, prm);
+    const auto w = to_host_vector(sphere.contact.tri_area_weight),
+               b = to_host_vector(sphere.contact.tri_beta),
+               fa = to_host_vector(sphere.contact.tri_friction_area),
+               area = to_host_vector(sphere.geo.tri_area);
+    for (int t = 0; t < sphere.mesh.n_tris; ++t) {
+      if (fa[t] > 0) {
+        ASSERT_NEAR(w[3 * t] + w[3 * t + 1] + w[3 * t + 2], 1.0, 1e-12);
+        for (int k = 0; k < 3; ++k) ASSERT_GE(w[3 * t + k], 0.0);
+      }
+      if (!w_prev.empty())
+        for (int k = 0; k < 3; ++k) {  // the node's share of the triangle's friction area, per A_t
+          worst_w =
+              std::fmax(worst_w, std::fabs(w[3 * t + k] * fa[t] - w_prev[3 * t + k] * fa_prev[t]) / area[t]);
+          worst_beta = std::fmax(worst_beta,
+                                 std::fabs(b[3 * t + k] * fa[t] - b_prev[3 * t + k] * fa_prev[t]) / area[t]);
+        }
+    }
+    w_prev = w;
+    b_prev = b;
+    fa_prev = fa;
+  }
+  std::printf(
+      "  largest change of a node's friction share (w_i A^f_t / A_t) per h0/400 step: area weights %.4f, "
+      "load shares (beta) %.4f\n",
+      worst_w, worst_beta);
+  EXPECT_LT(worst_w, 0.02);
+  // Deep in the contact the central triangles lie wholly inside the zone: 1/3 each (the projection's tilt).
+  sphere.load_at(0.3e-6, prm);
+  const auto w = to_host_vector(sphere.contact.tri_area_weight),
+             fa = to_host_vector(sphere.contact.tri_friction_area),
+             ca = to_host_vector(sphere.contact.tri_contact_area), area = to_host_vector(sphere.geo.tri_area);
+  int full = 0;
+  for (int t = 0; t < sphere.mesh.n_tris; ++t)
+    if (ca[t] > 0.9 * area[t] && fa[t] >= ca[t]) {
+      const auto r = to_host_vector(sphere.contact.tri_regime);
+      if (r[t] != kFullContact) continue;
+      ++full;
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(w[3 * t + k], 1.0 / 3.0, 0.02) << "triangle " << t;
+    }
+  EXPECT_GT(full, 0);
 }
 
 void expect_finite_and_consistent(const MeshContact& c, const std::string& what) {
