@@ -27,48 +27,47 @@ KOKKOS_INLINE_FUNCTION Real3 sym3_times(const double a0, const double a1, const 
   return {a0 * v.x + a3 * v.y + a4 * v.z, a3 * v.x + a1 * v.y + a5 * v.z, a4 * v.x + a5 * v.y + a2 * v.z};
 }
 
-// out = b − A x, the residual; one gather per row.
+// Row i of A x: one gather over the row's blocks.
+template <class Offsets, class Cols, class Values, class Vector>
+KOKKOS_INLINE_FUNCTION Real3 block_row_times(const Offsets& off, const Cols& cols, const Values& val,
+                                             const Vector& x, int i) {
+  Real3 acc{0, 0, 0};
+  for (int s = off(i); s < off(i + 1); ++s)
+    acc += sym3_times(val(s, 0), val(s, 1), val(s, 2), val(s, 3), val(s, 4), val(s, 5), load3(x, cols(s)));
+  return acc;
+}
+
+// out = b − A x, the residual (b = nullptr: out = A x, the product; the velocity solve's operator where the
+// multigrid's level 0 holds it, solvers/cortex_model.hpp).
 // active (optional): only the rows of these cells (core/cell_params.hpp; needs row_cell).
 template <class ExecutionSpace, class MemorySpace, class Vector>
-void block_csr_residual(const ExecutionSpace& space, const BlockCsr<MemorySpace>& a, const Vector& b,
+void block_csr_residual(const ExecutionSpace& space, const BlockCsr<MemorySpace>& a, const Vector* b,
                         const Vector& x, const Vector& out, const CellFlags<MemorySpace>& active = {}) {
   const auto row_cell = a.row_cell;
   const auto off = a.row_offsets;
   const auto cols = a.cols;
   const auto val = a.values;
+  const bool residual = b != nullptr;
+  const Vector rhs = residual ? *b : Vector();
   Kokkos::parallel_for(
-      "dcm::bsr::residual", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows),
-      KOKKOS_LAMBDA(const int i) {
+      residual ? "dcm::bsr::residual" : "dcm::bsr::multiply",
+      Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows), KOKKOS_LAMBDA(const int i) {
         if (skipped(active, row_cell(i))) return;
-        Real3 acc = load3(b, i);
-        for (int s = off(i); s < off(i + 1); ++s) {
-          const Real3 y =
-              sym3_times(val(s, 0), val(s, 1), val(s, 2), val(s, 3), val(s, 4), val(s, 5), load3(x, cols(s)));
-          acc = acc - y;
-        }
-        store3(out, i, acc);
+        const Real3 ax = block_row_times(off, cols, val, x, i);
+        store3(out, i, residual ? load3(rhs, i) - ax : ax);
       });
 }
+template <class ExecutionSpace, class MemorySpace, class Vector>
+void block_csr_residual(const ExecutionSpace& space, const BlockCsr<MemorySpace>& a, const Vector& b,
+                        const Vector& x, const Vector& out, const CellFlags<MemorySpace>& active = {}) {
+  block_csr_residual(space, a, &b, x, out, active);
+}
 
-// out = A x; one gather per row. The velocity solve's operator where the multigrid's level 0 holds it
-// (solvers/cortex_model.hpp). active (optional): only the rows of these cells.
+// out = A x.
 template <class ExecutionSpace, class MemorySpace, class Vector>
 void block_csr_multiply(const ExecutionSpace& space, const BlockCsr<MemorySpace>& a, const Vector& x,
                         const Vector& out, const CellFlags<MemorySpace>& active = {}) {
-  const auto row_cell = a.row_cell;
-  const auto off = a.row_offsets;
-  const auto cols = a.cols;
-  const auto val = a.values;
-  Kokkos::parallel_for(
-      "dcm::bsr::multiply", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows),
-      KOKKOS_LAMBDA(const int i) {
-        if (skipped(active, row_cell(i))) return;
-        Real3 acc{0, 0, 0};
-        for (int s = off(i); s < off(i + 1); ++s)
-          acc +=
-              sym3_times(val(s, 0), val(s, 1), val(s, 2), val(s, 3), val(s, 4), val(s, 5), load3(x, cols(s)));
-        store3(out, i, acc);
-      });
+  block_csr_residual(space, a, static_cast<const Vector*>(nullptr), x, out, active);
 }
 
 // Inverts every diagonal block (the block-Jacobi smoother's D⁻¹).
