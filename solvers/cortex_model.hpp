@@ -25,6 +25,7 @@
 #include "kernels/cortex_diagnostics.hpp"
 #include "kernels/external_forces.hpp"
 #include "kernels/fene_pow_bonds.hpp"
+#include "kernels/membrane_forces.hpp"
 #include "kernels/plane_contact.hpp"
 #include "kernels/volume_constraint.hpp"
 #include "solvers/bending_stiffness.hpp"
@@ -66,6 +67,9 @@ struct MechanicsParams {
   bool lumped_friction =
       true;  // substrate friction w_i Γ_t per node (false: β_i β_j Γ_t), friction_operator.hpp
   bool area_friction_weights = true;  // lumped: w_i from the friction area's centroid (false: the load's)
+  // With bonds, bending, area and volume terms: the fused membrane pass (kernels/membrane_forces.hpp;
+  // false: one kernel per term). The same forces to rounding.
+  bool fused_membrane = true;
 };
 
 // Why cells with parameters a and b cannot share the buffers of one batch ("" if they can): what decides
@@ -102,6 +106,7 @@ inline std::string batch_mismatch(const MechanicsParams& a, const MechanicsParam
            a.contact.friction_on_adhesive_zone != b.contact.friction_on_adhesive_zone},
       {"substrate friction on/off", on(a.gamma_n) != on(b.gamma_n) || on(a.gamma_t) != on(b.gamma_t) ||
                                         on(a.pin_friction) != on(b.pin_friction)},
+      {"the membrane pass (fused or per term)", a.fused_membrane != b.fused_membrane},
       {"lumped substrate friction",
        a.lumped_friction != b.lumped_friction || a.area_friction_weights != b.area_friction_weights},
   };
@@ -158,6 +163,8 @@ class CortexModel {
     if (p.k_area_local > 0 || p.k_area_global > 0) area_ = make_area_rest(space_, mesh_, geo_);
     if (area_ && p.implicit_tension) tension_stiffness_ = TensionStiffness<Mem>(mesh_);
     if (p.k_volume > 0) volume_ = make_volume_rest(space_, mesh_, geo_);
+    if (p.fused_membrane && bonds_ && hinges_ && area_ && volume_ && bonds_match_hinges(mesh_))
+      membrane_ = MembraneScratch<Mem>(mesh_);
     if (p.k_area_global > 0 || p.k_volume > 0)
       global_ = GlobalStiffness<Mem>(mesh_, p.k_area_global > 0, p.k_volume > 0);
     if (p.gravity != 0 && p.density_excess != 0) gravity_ = node_weights(cells);
@@ -299,17 +306,27 @@ class CortexModel {
   void compute_forces() {
     update_geometry(space_, mesh_, geo_, params_.h_min);
     Kokkos::deep_copy(space_, force_, 0.0);
-    if (bonds_) {
+    if (membrane_) {  // all four membrane terms in three passes (kernels/membrane_forces.hpp)
       Kokkos::deep_copy(space_, overstretched_, -1);
-      add_fene_pow_forces(space_, mesh_, *bonds_, bond_params_.table(), force_, overstretched_);
+      add_membrane_forces(space_, mesh_, geo_, *bonds_, bond_params_.table(), *hinges_, k_b_.table(), *area_,
+                          k_area_local_.table(), k_area_global_.table(), *volume_, k_volume_.table(),
+                          *membrane_, force_, overstretched_);
       int bad = -1;
       Kokkos::deep_copy(bad, overstretched_);
       if (bad >= 0) throw NumericalError(describe_overstretch(bad));
+    } else {
+      if (bonds_) {
+        Kokkos::deep_copy(space_, overstretched_, -1);
+        add_fene_pow_forces(space_, mesh_, *bonds_, bond_params_.table(), force_, overstretched_);
+        int bad = -1;
+        Kokkos::deep_copy(bad, overstretched_);
+        if (bad >= 0) throw NumericalError(describe_overstretch(bad));
+      }
+      if (hinges_) add_bending_forces(space_, mesh_, *hinges_, k_b_.table(), force_);
+      if (area_)
+        add_area_forces(space_, mesh_, geo_, *area_, k_area_local_.table(), k_area_global_.table(), force_);
+      if (volume_) add_volume_forces(space_, mesh_, geo_, *volume_, k_volume_.table(), force_);
     }
-    if (hinges_) add_bending_forces(space_, mesh_, *hinges_, k_b_.table(), force_);
-    if (area_)
-      add_area_forces(space_, mesh_, geo_, *area_, k_area_local_.table(), k_area_global_.table(), force_);
-    if (volume_) add_volume_forces(space_, mesh_, geo_, *volume_, k_volume_.table(), force_);
     add_external_forces(space_, external_, force_);
     if (gravity_) add_external_forces(space_, *gravity_, force_);
     if (contact_) {
@@ -640,6 +657,7 @@ class CortexModel {
   std::optional<HingeRest<Mem>> hinges_;
   std::optional<AreaRest<Mem>> area_;
   std::optional<VolumeRest<Mem>> volume_;
+  std::optional<MembraneScratch<Mem>> membrane_;  // set: the fused membrane pass
   std::optional<GlobalStiffness<Mem>> global_;
   std::optional<Multigrid<Mem>> multigrid_;
   std::optional<BendingStiffness<Mem>> bending_stiffness_;

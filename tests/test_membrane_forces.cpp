@@ -1,0 +1,150 @@
+// The fused membrane pass (kernels/membrane_forces.hpp) against the per-term kernels it replaces: the same
+// forces, the same hinge scratch (gradient, -M, cos(theta - theta*)) that the implicit bending stiffness
+// reads, the same overstretch flag, on two cells with different constants; and the model's choice.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "core/host_copy.hpp"
+#include "core/update_geometry.hpp"
+#include "kernels/membrane_forces.hpp"
+
+namespace dcm {
+namespace {
+
+using Exec = Kokkos::DefaultExecutionSpace;
+using Mem = Exec::memory_space;
+using Vector = Kokkos::View<double* [3], Kokkos::LayoutRight, Mem>;
+
+// Two cells of 162 nodes (the second 10 µm away), rest state the spheres, then every coordinate scaled by
+// a random factor in [0.97, 1.03]; hinge rest angles 0 (so every hinge bends) in cell 0, the sphere's in
+// cell 1. Constants per cell, deliberately different.
+struct TwoCells {
+  Exec space;
+  MeshBuffers<Mem> mesh;
+  GeometryBuffers<Mem> geo;
+  BondRest<Mem> bonds;
+  HingeRest<Mem> hinges;
+  AreaRest<Mem> area;
+  VolumeRest<Mem> volume;
+  PerCell<FenePowParams, Mem> bond_params{{FenePowParams{3.2e-6, 2.05}, FenePowParams{6.4e-6, 2.6}}};
+  PerCell<double, Mem> k_b{{2.4e-19, 7e-19}}, k_a{{6e-3, 0.0}}, k_d{{6e-3, 2e-2}}, k_v{{1e4, 3e3}};
+  MembraneScratch<Mem> scratch;
+  Kokkos::View<int, Mem> overstretched{"overstretched"};
+
+  static std::vector<HostCell> cells() {
+    HostMesh a = make_icosphere(2, 3.25e-6), b = make_icosphere(2, 2.5e-6);
+    translate(b, {10e-6, 0, 0});
+    return {HostCell(a), HostCell(b)};
+  }
+  TwoCells() : mesh(upload_cells<Mem>(cells())), geo(mesh), scratch(mesh) {
+    update_geometry(space, mesh, geo, 1e4);
+    bonds = make_bond_rest(space, mesh);
+    hinges = make_hinge_rest(space, mesh);
+    area = make_area_rest(space, mesh, geo);
+    volume = make_volume_rest(space, mesh, geo);
+    auto trig = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), hinges.rest_trig);
+    const int cell0_hinges = static_cast<int>(trig.extent(0)) / 2;
+    for (int h = 0; h < cell0_hinges; ++h) {
+      trig(h, 0) = 1;
+      trig(h, 1) = 0;
+    }
+    Kokkos::deep_copy(hinges.rest_trig, trig);
+    auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.x);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(0.97, 1.03);
+    for (int i = 0; i < mesh.n_nodes; ++i)
+      for (int d = 0; d < 3; ++d) x(i, d) *= u(rng);
+    Kokkos::deep_copy(mesh.x, x);
+    update_geometry(space, mesh, geo, 1e4);
+  }
+  // Forces and overstretch flag of the per-term kernels (fused = false) or the fused pass.
+  std::vector<double> forces(bool fused, int* flag = nullptr) {
+    Vector f("f", mesh.n_nodes);
+    Kokkos::deep_copy(overstretched, -1);
+    if (fused) {
+      add_membrane_forces(space, mesh, geo, bonds, bond_params.table(), hinges, k_b.table(), area,
+                          k_a.table(), k_d.table(), volume, k_v.table(), scratch, f, overstretched);
+    } else {
+      add_fene_pow_forces(space, mesh, bonds, bond_params.table(), f, overstretched);
+      add_bending_forces(space, mesh, hinges, k_b.table(), f);
+      add_area_forces(space, mesh, geo, area, k_a.table(), k_d.table(), f);
+      add_volume_forces(space, mesh, geo, volume, k_v.table(), f);
+    }
+    if (flag) Kokkos::deep_copy(*flag, overstretched);
+    return to_host_vector(f);
+  }
+  std::vector<double> hinge_scratch() const {
+    const auto g = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), hinges.hinge_grad);
+    std::vector<double> s(g.data(), g.data() + g.size()), m = to_host_vector(hinges.hinge_moment),
+                                                          c = to_host_vector(hinges.hinge_cos_delta);
+    s.insert(s.end(), m.begin(), m.end());
+    s.insert(s.end(), c.begin(), c.end());
+    return s;
+  }
+};
+
+double max_abs(const std::vector<double>& v) {
+  double m = 0;
+  for (double a : v) m = std::max(m, std::abs(a));
+  return m;
+}
+double max_diff(const std::vector<double>& a, const std::vector<double>& b) {
+  double m = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) m = std::max(m, std::abs(a[k] - b[k]));
+  return m;
+}
+
+TEST(MembraneForces, BondsAndHingesAreNumberedAlike) {
+  TwoCells s;
+  EXPECT_TRUE(bonds_match_hinges(s.mesh));
+}
+
+TEST(MembraneForces, FusedPassEqualsThePerTermKernels) {
+  TwoCells s;
+  const std::vector<double> per_term = s.forces(false), scratch_per_term = s.hinge_scratch();
+  const std::vector<double> fused = s.forces(true), scratch_fused = s.hinge_scratch();
+  ASSERT_GT(max_abs(per_term), 0);
+  EXPECT_LE(max_diff(per_term, fused), 1e-11 * max_abs(per_term));
+  EXPECT_LE(max_diff(scratch_per_term, scratch_fused), 1e-11 * max_abs(scratch_per_term));
+  // Each term alone also matches (a term dropped or doubled by the fused pass would show here, even where
+  // another term dominates the sum): switch all but one off by zeroing its constants.
+  const PerCell<double, Mem> zero{{0.0, 0.0}};
+  for (int term = 0; term < 4; ++term) {
+    TwoCells t;
+    if (term != 1) t.k_b = zero;
+    if (term != 2) t.k_a = zero, t.k_d = zero;
+    if (term != 3) t.k_v = zero;
+    if (term != 0)
+      t.bond_params = PerCell<FenePowParams, Mem>({FenePowParams{0.0, 2.05}, FenePowParams{0.0, 2.6}});
+    const std::vector<double> a = t.forces(false), b = t.forces(true);
+    ASSERT_GT(max_abs(a), 0) << "term " << term;
+    EXPECT_LE(max_diff(a, b), 1e-11 * max_abs(a)) << "term " << term;
+  }
+}
+
+TEST(MembraneForces, OverstretchedBondIsFlaggedLikeThePerTermKernel) {
+  TwoCells s;
+  int flag_fused = -2, flag_terms = -2;
+  s.forces(true, &flag_fused);
+  EXPECT_EQ(flag_fused, -1);
+  // Pull node 5 of cell 1 outwards by 3 µm: its bonds pass d_max (x_max d* ≈ 1.3 µm here).
+  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), s.mesh.x);
+  const int node = 162 + 5;
+  x(node, 2) += 3e-6;
+  Kokkos::deep_copy(s.mesh.x, x);
+  update_geometry(s.space, s.mesh, s.geo, 1e4);
+  const std::vector<double> fused = s.forces(true, &flag_fused);
+  s.forces(false, &flag_terms);
+  ASSERT_GE(flag_fused, 0);
+  ASSERT_GE(flag_terms, 0);
+  const auto bond = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), s.mesh.bond);
+  EXPECT_TRUE(bond(flag_fused, 0) == node || bond(flag_fused, 1) == node) << "bond " << flag_fused;
+  EXPECT_TRUE(bond(flag_terms, 0) == node || bond(flag_terms, 1) == node) << "bond " << flag_terms;
+  for (double f : fused) EXPECT_TRUE(std::isfinite(f));  // the bad bonds add nothing, and no NaN
+}
+
+}  // namespace
+}  // namespace dcm
