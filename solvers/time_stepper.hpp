@@ -70,7 +70,7 @@ class TimeStepper {
         v_prev_(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::batch::v_prev"), model.mesh().n_nodes),
         v_prev2_(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::batch::v_prev2"),
                  model.mesh().n_nodes),
-        cell_h_(std::vector<double>(n_, 0.0), "dcm::batch::h"),
+        cell_s_(std::vector<double>(n_, 0.0), "dcm::batch::factor"),
         cell_on_(std::vector<double>(n_, 0.0), "dcm::batch::on") {}
 
   const TimeStepSettings& settings() const { return settings_; }
@@ -174,7 +174,7 @@ class TimeStepper {
     observe(h);
     Kokkos::deep_copy(x_prev_, model.positions());
     if (!settings_.adaptive) {  // v(t_{n−1}) for the next step's extrapolated warm start
-      combine_cells(model, stepping, std::vector<double>(n_, 0.0), v_prev2_, v_prev_, v_prev_,
+      combine_cells(model, stepping, std::vector<double>(n_, 0.0), v_prev2_, v_prev_, v_prev_, Vector(),
                     "dcm::stepper::keep_velocity");
       for (int c = 0; c < n_; ++c)
         if (stepping[c]) {
@@ -294,63 +294,47 @@ class TimeStepper {
     std::vector<char> extrapolated(n_, 0);
     for (int c = 0; c < n_; ++c)
       extrapolated[c] = cells[c] && has_prev_[c] && has_prev2_[c] && h_prev_[c] == h_prev2_[c];
-    combine_cells(model, extrapolated, std::vector<double>(n_, 1.0), model.velocity(), v_prev_, v_prev2_,
-                  "dcm::stepper::extrapolate_velocity");
+    combine_cells(model, extrapolated, std::vector<double>(n_, 1.0), model.velocity(), v_prev_, v_prev_,
+                  v_prev2_, "dcm::stepper::extrapolate_velocity");
   }
-  // On the nodes of the flagged cells: out = a + s_c (a − b).
+  // x = x_prev + h_prev v_prev on the flagged cells.
+  void redo_previous_step(Model& model, const std::vector<char>& cells) {
+    combine_cells(model, cells, h_prev_, model.positions(), x_prev_, v_prev_, Vector(), "dcm::stepper::redo");
+  }
+  // x += h v on the flagged cells (forward Euler, paper eq. 32).
+  void advance(Model& model, const std::vector<char>& cells, const std::vector<double>& h) {
+    combine_cells(model, cells, h, model.positions(), model.positions(), model.velocity(), Vector(),
+                  "dcm::integrator::euler");
+  }
+  // x = x_prev on the flagged cells.
+  void restore_positions(Model& model, const std::vector<char>& cells) {
+    combine_cells(model, cells, std::vector<double>(n_, 0.0), model.positions(), x_prev_, x_prev_, Vector(),
+                  "dcm::stepper::restore");
+  }
+  // On the nodes of the flagged cells: out = u + s_c (v − w), or out = u where s_c = 0 (a copy, whatever v
+  // holds: a restore after a failed step must not multiply a non-finite velocity by 0). w: an empty View
+  // stands for zero.
   void combine_cells(const Model& model, const std::vector<char>& cells, const std::vector<double>& s,
-                     const Vector& out, const Vector& a, const Vector& b, const char* label) {
+                     const Vector& out, const Vector& u, const Vector& v, const Vector& w,
+                     const char* label) {
+    if (!any(cells)) return;
     std::vector<double> factor(n_, 0.0);
-    bool any_on = false;
     for (int c = 0; c < n_; ++c)
-      if (cells[c]) {
-        factor[c] = s[c];
-        any_on = true;
-      }
-    if (!any_on) return;
-    cell_h_.assign(factor);
+      if (cells[c]) factor[c] = s[c];
+    cell_s_.assign(factor);
     cell_on_.assign(std::vector<double>(cells.begin(), cells.end()));
-    const auto f = cell_h_.values;
+    const auto f = cell_s_.values;
     const auto flag = cell_on_.values;
     const auto node_cell = model.mesh().node_cell;
+    const bool has_w = w.extent(0) > 0;
     Kokkos::parallel_for(
         label, Kokkos::RangePolicy<ExecutionSpace>(model.space(), 0, out.extent(0)),
         KOKKOS_LAMBDA(const int i) {
           const int c = node_cell(i);
           if (flag(c) == 0) return;
           const double fc = f(c);
-          for (int d = 0; d < 3; ++d) out(i, d) = a(i, d) + fc * (a(i, d) - b(i, d));
-        });
-  }
-
-  // x = x_prev + h_prev v_prev on the flagged cells.
-  void redo_previous_step(Model& model, const std::vector<char>& cells) {
-    move_cells(model, cells, h_prev_, x_prev_, v_prev_, false, "dcm::stepper::redo");
-  }
-  // x += h v on the flagged cells (forward Euler, paper eq. 32).
-  void advance(Model& model, const std::vector<char>& cells, const std::vector<double>& h) {
-    move_cells(model, cells, h, model.positions(), model.velocity(), false, "dcm::integrator::euler");
-  }
-  // x = x_prev on the flagged cells.
-  void restore_positions(Model& model, const std::vector<char>& cells) {
-    move_cells(model, cells, std::vector<double>(n_, 1.0), x_prev_, v_prev_, true, "dcm::stepper::restore");
-  }
-  // On the nodes of the flagged cells: x = base + s_c dir (copy: x = base).
-  void move_cells(Model& model, const std::vector<char>& cells, const std::vector<double>& s,
-                  const Vector& base, const Vector& dir, bool copy, const char* label) {
-    std::vector<double> factor(n_, 0.0);
-    for (int c = 0; c < n_; ++c)
-      if (cells[c]) factor[c] = s[c];
-    cell_h_.assign(factor);
-    const auto x = model.positions();
-    const auto f = cell_h_.values;
-    const auto node_cell = model.mesh().node_cell;
-    Kokkos::parallel_for(
-        label, Kokkos::RangePolicy<ExecutionSpace>(model.space(), 0, x.extent(0)),
-        KOKKOS_LAMBDA(const int i) {
-          const double fc = f(node_cell(i));
-          if (fc == 0) return;
-          for (int d = 0; d < 3; ++d) x(i, d) = copy ? base(i, d) : base(i, d) + fc * dir(i, d);
+          for (int d = 0; d < 3; ++d)
+            out(i, d) = fc == 0 ? u(i, d) : u(i, d) + fc * (has_w ? v(i, d) - w(i, d) : v(i, d));
         });
   }
 
@@ -358,8 +342,8 @@ class TimeStepper {
   int n_;
   std::vector<double> t_, h_next_, h_prev_, h_prev2_;
   std::vector<char> has_prev_, has_prev2_;
-  Vector x_prev_, v_prev_, v_prev2_;  // v_prev2_: v(t_{n−1}), fixed steps only
-  PerCell<double, Mem> cell_h_, cell_on_;
+  Vector x_prev_, v_prev_, v_prev2_;       // v_prev2_: v(t_{n−1}), fixed steps only
+  PerCell<double, Mem> cell_s_, cell_on_;  // combine_cells()'s factor and flag per cell
 };
 
 }  // namespace dcm
