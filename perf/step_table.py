@@ -6,6 +6,8 @@ usage: step_table.py BENCH.csv [--ns]   (--ns: ns per node per step instead of Â
 Kernels are grouped by what they do in a step:
   geometry      triangle areas/normals, curvature, rounded-triangle spheres, cell area and volume
   bonds, bending, area, volume, external   the force terms (bending: hinge pass + gather)
+  membrane (fused)  the four membrane terms in one triangle pass, one edge pass and a gather
+                (kernels/membrane_forces.hpp; the default when all four are on)
   contact       plane contact per triangle, gather, sums
   solver set-up per step: bond directions, block-Jacobi blocks, implicit bending/tension/global stiffness,
                 multigrid fine assembly and Galerkin products, smoother diagonal
@@ -22,6 +24,7 @@ GROUPS = [
     ("bending", ("dcm::bending::",)),
     ("area", ("dcm::area::",)),
     ("volume", ("dcm::volume::",)),
+    ("membrane (fused)", ("dcm::membrane::",)),
     ("contact", ("dcm::contact::",)),
     ("solver set-up", ("dcm::friction::bond_directions", "dcm::friction::block_jacobi",
                        "dcm::friction::substrate_triangles", "dcm::bending_stiffness::update",
