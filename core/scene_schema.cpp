@@ -154,6 +154,9 @@ std::vector<ParamSpec> make_schema() {
                "adaptive: allowed local position error per step"),
       real_key("time.dt_min_s", "1e-9", 0, 1, kExcl, "s", "adaptive: smallest step"),
       real_key("time.dt_max_s", "1e-3", 0, 1, kExcl, "s", "adaptive: largest step"),
+      real_key("time.contact_change", "0.01", 0, 1, kIncl, "",
+               "adaptive: largest relative change of the contact area per step (resolves the touch-down, "
+               "docs/model/time_stepping.md); 0: off"),
 
       real_key("solver.cg_abs_tol_N", "1e-14", 0, 1e-6, kIncl, "N",
                "CG stops when the force residual ||F − Γv||₂ is below this (the paper's 1e-14 N) ..."),

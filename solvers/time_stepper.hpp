@@ -13,6 +13,9 @@
 // against Heun's x₀ + h (v(x₀) + v(x₁))/2: e = (h/2) max_i |v_i(x₁) − v_i(x₀)| (m). v(x₁) is the next step's
 // velocity, so the estimate costs no extra solve (first same as last). If e > tol the previous step is taken
 // again, shorter; otherwise the next step is h · min(2, max(0.2, 0.9 √(tol/e))), within [dt_min, dt_max].
+// With settings.contact_change = q > 0 a step is also taken again when it changed a cell's contact area by
+// more than q relative (ρ = |ΔA| / max(A, Ā_t)), and the next step is at most h · 0.9 q / ρ: the contact
+// area grows at first order in h, and the position error does not see how far the contact line moved.
 //
 // Fixed steps: the velocity solve starts from the linear extrapolation 2 v(t_n) − v(t_{n−1}) of the last two
 // steps' velocities when both were one full step long (otherwise from v(t_n)): the same solution to the CG
@@ -35,6 +38,10 @@ struct TimeStepSettings {
   bool adaptive = false;                // error-controlled steps
   double error_tol_m = 1e-9;            // m: allowed local position error per step (adaptive)
   double dt_min = 1e-9, dt_max = 1e-3;  // s: bounds of the adaptive step
+  // adaptive: largest relative change of a cell's contact area per step, |ΔA_c| / max(A_c, Ā_t) (Ā_t: the
+  // cell's mean triangle area); 0: off. The position error misses the contact line's motion in the
+  // touch-down (docs/model/time_stepping.md, "Contact change per step").
+  double contact_change = 0;
   int max_halvings = 20;  // halvings for a bond near d_max before the run stops (NumericalError)
   // Halvings for a velocity solve that does not converge: if h/64 does not help, the operator is not the
   // problem a shorter step solves (indefinite or non-finite); the run stops instead of crawling.
@@ -70,6 +77,8 @@ class TimeStepper {
         v_prev_(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::batch::v_prev"), model.mesh().n_nodes),
         v_prev2_(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::batch::v_prev2"),
                  model.mesh().n_nodes),
+        contact_prev_(n_, -1.0),
+        contact_floor_(mean_triangle_areas(model)),
         cell_s_(std::vector<double>(n_, 0.0), "dcm::batch::factor"),
         cell_on_(std::vector<double>(n_, 0.0), "dcm::batch::on") {}
 
@@ -89,6 +98,7 @@ class TimeStepper {
     ck.put("stepper.h_prev2", h_prev2_[c]);
     ck.put("stepper.has_prev2", has_prev2_[c] ? 1.0 : 0.0);
     ck.put("stepper.v_prev2", model.cell_slice(v_prev2_, c));
+    ck.put("stepper.contact_prev", contact_prev_[c]);
   }
   // Cell c's stepper state from a checkpoint of it.
   void restore_cell_state(const Checkpoint& ck, const Model& model, int c) {
@@ -101,6 +111,8 @@ class TimeStepper {
     // A checkpoint of a dcm before the extrapolated warm start has no second velocity: the first step after
     // the restart starts its solve from v(t_n).
     has_prev2_[c] = ck.arrays.count("stepper.has_prev2") && ck.scalar("stepper.has_prev2") != 0;
+    // Older checkpoints have no contact area: the first step after the restart skips the contact check.
+    contact_prev_[c] = ck.arrays.count("stepper.contact_prev") ? ck.scalar("stepper.contact_prev") : -1.0;
     if (has_prev2_[c]) {
       h_prev2_[c] = ck.scalar("stepper.h_prev2");
       model.set_cell_slice(v_prev2_, c, ck.array("stepper.v_prev2"));
@@ -142,17 +154,24 @@ class TimeStepper {
       for (int c = 0; c < n_; ++c) checking[c] = stepping[c] && has_prev_[c];
       while (any(checking)) {
         const std::vector<double> dv = velocity_change(model);
+        const std::vector<double> rho = contact_change(model);
         std::vector<char> rejected(n_, 0);
         for (int c = 0; c < n_; ++c) {
           if (!checking[c]) continue;
           const double err = 0.5 * h_prev_[c] * dv[c];
           rep[c].error_m = err;
-          if (err <= settings_.error_tol_m || h_prev_[c] <= settings_.dt_min * (1 + 1e-12)) {
-            h[c] = std::min(grow(h_prev_[c], err), h_cap[c]);
+          const double q = settings_.contact_change;
+          const bool contact_ok = !(q > 0) || rho[c] <= q;
+          if ((err <= settings_.error_tol_m && contact_ok) || h_prev_[c] <= settings_.dt_min * (1 + 1e-12)) {
+            double next = grow(h_prev_[c], err);
+            if (q > 0 && rho[c] > 0) next = std::min(next, h_prev_[c] * std::max(0.2, 0.9 * q / rho[c]));
+            h[c] = std::min(next, h_cap[c]);
             checking[c] = 0;
             continue;
           }
-          const double shorter = std::max(settings_.dt_min, h_prev_[c] * shrink_factor(err));
+          double factor = err > settings_.error_tol_m ? shrink_factor(err) : 0.9;
+          if (!contact_ok) factor = std::min(factor, std::max(0.2, 0.9 * q / rho[c]));
+          const double shorter = std::max(settings_.dt_min, h_prev_[c] * factor);
           t_[c] += shorter - h_prev_[c];
           h_prev_[c] = shorter;
           rejected[c] = 1;
@@ -164,6 +183,11 @@ class TimeStepper {
         for (int c = 0; c < n_; ++c)
           if (rejected[c]) h_solved[c] = h_prev_[c];
         solve(model, cg, rejected, h_solved, rep);
+      }
+      if (settings_.contact_change > 0) {  // A_c at the start of this step, for the next step's check
+        const std::vector<double> a = cell_contact_areas(model);
+        for (int c = 0; c < n_; ++c)
+          if (stepping[c]) contact_prev_[c] = a[c];
       }
       // The implicit terms depend on h: solve again where the step changed by more than 10%.
       std::vector<char> again(n_, 0);
@@ -288,6 +312,30 @@ class TimeStepper {
     return m;
   }
 
+  // Each cell's contact area (m²) at the current positions (the contact of the last compute_forces()).
+  std::vector<double> cell_contact_areas(const Model& model) const {
+    std::vector<double> a(n_, 0.0);
+    model.contact_area(&a);
+    return a;
+  }
+  // ρ_c = |A_c − A_c(start of the last step)| / max(A_c, Ā_t) per cell; zeros when the criterion is off.
+  std::vector<double> contact_change(const Model& model) const {
+    std::vector<double> rho(n_, 0.0);
+    if (!(settings_.contact_change > 0)) return rho;
+    const std::vector<double> a = cell_contact_areas(model);
+    for (int c = 0; c < n_; ++c)  // < 0: no previous area (first step, older checkpoint), no check
+      rho[c] =
+          contact_prev_[c] < 0 ? 0.0 : std::fabs(a[c] - contact_prev_[c]) / std::max(a[c], contact_floor_[c]);
+    return rho;
+  }
+  static std::vector<double> mean_triangle_areas(const Model& model) {
+    const std::vector<double> area = to_host_vector(model.geometry().cell_area);
+    const std::vector<int>& begin = model.mesh().host_cell_tri_begin;
+    std::vector<double> mean(area.size());
+    for (std::size_t c = 0; c < area.size(); ++c) mean[c] = area[c] / (begin[c + 1] - begin[c]);
+    return mean;
+  }
+
   // The start of the velocity solve on the flagged cells whose last two steps were equally long (a fixed
   // step): v = v(t_n) + (v(t_n) − v(t_{n−1})); the others start from v(t_n), the model's last velocity.
   void extrapolate_warm_start(Model& model, const std::vector<char>& cells) {
@@ -342,7 +390,9 @@ class TimeStepper {
   int n_;
   std::vector<double> t_, h_next_, h_prev_, h_prev2_;
   std::vector<char> has_prev_, has_prev2_;
-  Vector x_prev_, v_prev_, v_prev2_;       // v_prev2_: v(t_{n−1}), fixed steps only
+  Vector x_prev_, v_prev_, v_prev2_;  // v_prev2_: v(t_{n−1}), fixed steps only
+  std::vector<double> contact_prev_;  // contact area per cell at the start of the last step (m²; −1: none)
+  std::vector<double> contact_floor_;      // its floor in ρ: the cell's mean triangle area (m²)
   PerCell<double, Mem> cell_s_, cell_on_;  // combine_cells()'s factor and flag per cell
 };
 

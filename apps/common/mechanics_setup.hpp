@@ -69,6 +69,7 @@ inline TimeStepSettings steps_from_scene(const Scene& scene) {
   s.error_tol_m = scene.get_real("time.error_tol_m");
   s.dt_min = scene.get_real("time.dt_min_s");
   s.dt_max = scene.get_real("time.dt_max_s");
+  s.contact_change = scene.get_real("time.contact_change");
   if (s.adaptive && !(s.dt_min <= s.dt && s.dt <= s.dt_max))
     throw SceneError("time.dt_s = " + std::to_string(s.dt) +
                      " is not allowed with time.adaptive = true: it must "
