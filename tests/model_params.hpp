@@ -1,5 +1,7 @@
 #pragma once
 // The paper's Table 1 cortex as dcm reads it (docs/MODEL.md), for tests that build a CortexModel.
+#include <cmath>
+
 #include "solvers/cortex_model.hpp"
 
 namespace dcm::test_params {
@@ -13,6 +15,22 @@ inline MechanicsParams table1_cortex() {
   p.k_volume = 1e4;          // Pa
   p.dashpot = 1.5e-6;        // N·s/m
   p.viscosity = 0.8e-3;      // Pa·s
+  return p;
+}
+
+// Table 1 on a plane the sphere of radius r just overlaps (contact radius a), with the spreading scene's
+// solver options (multigrid, implicit bending and tension) and substrate friction (Hategan's W = 1 mJ/m²,
+// h0 = 20 nm, γ_n = 8e9, γ_t = 6e9 N·s/m³).
+inline MechanicsParams spreading_on_plane(double r, double a) {
+  MechanicsParams p = table1_cortex();
+  p.multigrid = true;
+  p.implicit_bending = true;
+  p.implicit_tension = true;
+  p.has_plane = true;
+  p.plane.point = {0, 0, -r + (r - std::sqrt(r * r - a * a))};
+  p.contact.material = md_material(800e3, 0.4, 1e-3, 20e-9);
+  p.gamma_n = 8e9;
+  p.gamma_t = 6e9;
   return p;
 }
 

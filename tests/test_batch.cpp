@@ -22,15 +22,7 @@ using Exec = Kokkos::DefaultExecutionSpace;
 // are the load shares (contact.friction_weights = "lumped"), not the default area weights: their jumps
 // provoke the halvings and rejections these tests need to exercise.
 MechanicsParams spreading(double r, double a) {
-  MechanicsParams p = test_params::table1_cortex();
-  p.multigrid = true;
-  p.implicit_bending = true;
-  p.implicit_tension = true;
-  p.has_plane = true;
-  p.plane.point = {0, 0, -r + (r - std::sqrt(r * r - a * a))};
-  p.contact.material = md_material(800e3, 0.4, 1e-3, 20e-9);
-  p.gamma_n = 8e9;
-  p.gamma_t = 6e9;
+  MechanicsParams p = test_params::spreading_on_plane(r, a);
   p.area_friction_weights = false;
   return p;
 }

@@ -145,15 +145,7 @@ TEST(TimeStepper, AdaptiveErrorFollowsTheTolerance) {
 // spreading scene's solver options, 642 nodes, 4 ms.
 TEST(TimeStepper, ContactChangeBoundsTheContactAreaPerStep) {
   const double r = 3.25e-6, a = 0.3e-6, t_end = 0.004;
-  MechanicsParams p = table1();
-  p.multigrid = true;
-  p.implicit_bending = true;
-  p.implicit_tension = true;
-  p.has_plane = true;
-  p.plane.point = {0, 0, -r + (r - std::sqrt(r * r - a * a))};
-  p.contact.material = md_material(800e3, 0.4, 1e-3, 20e-9);
-  p.gamma_n = 8e9;
-  p.gamma_t = 6e9;
+  const MechanicsParams p = test_params::spreading_on_plane(r, a);
   const HostMesh sphere = make_icosphere(3, r);
   auto largest_change = [&](double q, int& steps) {
     CortexModel<Exec> m(Exec(), {HostCell(sphere)}, p);
