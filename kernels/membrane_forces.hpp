@@ -31,23 +31,14 @@
 
 namespace dcm {
 
-// Items per work item of the triangle and edge passes.
+// Items per work item of the triangle and edge passes: 8 where the execution space runs on the host (SIMD
+// lanes), 1 on a device (CUDA, HIP, SYCL: one thread per item).
 template <class ExecutionSpace>
 struct MembraneLanes {
-  static constexpr int value = 8;
+  static constexpr int value =
+      Kokkos::SpaceAccessibility<Kokkos::HostSpace, typename ExecutionSpace::memory_space>::accessible ? 8
+                                                                                                       : 1;
 };
-#ifdef KOKKOS_ENABLE_CUDA
-template <>
-struct MembraneLanes<Kokkos::Cuda> {
-  static constexpr int value = 1;
-};
-#endif
-#ifdef KOKKOS_ENABLE_HIP
-template <>
-struct MembraneLanes<Kokkos::Experimental::HIP> {
-  static constexpr int value = 1;
-};
-#endif
 
 // Scratch of the passes (allocated once per mesh).
 template <class MemorySpace>
