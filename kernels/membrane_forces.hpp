@@ -15,9 +15,9 @@
 //    stiffness reads them).
 // 3. Node gather over the node's (hinge, role) and (triangle, corner) lists: no atomics, deterministic.
 //
-// Passes 1 and 2 work on kMembraneLanes consecutive items per work item, loaded into small local arrays and
+// Passes 1 and 2 work on MembraneLanes consecutive items per work item, loaded into small local arrays and
 // computed in straight-line loops over the lanes, which the host compiler turns into SIMD instructions (8
-// doubles per AVX-512 instruction); on a GPU a work item is one item (kMembraneLanes = 1).
+// doubles per AVX-512 instruction); on a GPU a work item is one item (MembraneLanes = 1).
 //
 // Expectations (tests/test_membrane_forces.cpp): the same forces, hinge scratch and overstretch flag as the
 // per-term kernels (to rounding), on meshes with several cells and per-cell constants.
