@@ -5,15 +5,16 @@
 //   kernels/fene_pow_bonds.hpp      eqs. 21-24     kernels/bending.hpp         eq. 26
 //   kernels/area_constraints.hpp    eqs. 27-28     kernels/volume_constraint.hpp  eq. 29
 //
-// 1. Triangle pass: each corner's area and volume force (9 doubles per triangle into a scratch),
+// 1. Triangle pass: each corner's area and volume force,
 //      F_a = -(1/2) [k_a (A_t - A_t*)/A_t* + k_d (A_c - A_c*)/A_c*] n_t x (x_c - x_b)   (eqs. 27, 28)
 //            - k_v (V_c - V_c*)/V_c* (A_t/3) n_t                                        (eq. 29)
 // 2. Edge pass: an edge is both a bond and a hinge (core/host_mesh.cpp numbers them alike); its bond force
 //    and its hinge's four bending forces in one evaluation that shares |x_j - x_i| and the reciprocals
-//    (one division per edge), the four forces into a scratch (12 doubles per edge). The hinge's gradient,
-//    -M and cos(theta - theta*) go into HingeRest as add_bending_forces() leaves them (the implicit bending
-//    stiffness reads them).
-// 3. Node gather over the node's (hinge, role) and (triangle, corner) lists: no atomics, deterministic.
+//    (one division per edge). The hinge's gradient, -M and cos(theta - theta*) go into HingeRest as
+//    add_bending_forces() leaves them (the implicit bending stiffness reads them).
+// 3. Node gather. Passes 1 and 2 write each node's share (3 doubles) into a slot of that node's contiguous
+//    range of the scratch (fill_membrane_slots()); the gather sums the range: no atomics, deterministic,
+//    and no scattered reads (the scattered accesses are the passes' stores).
 //
 // Passes 1 and 2 work on MembraneLanes consecutive items per work item, loaded into small local arrays and
 // computed in straight-line loops over the lanes, which the host compiler turns into SIMD instructions (8
@@ -40,15 +41,41 @@ struct MembraneLanes {
                                                                                                        : 1;
 };
 
-// Scratch of the passes (allocated once per mesh).
+// The slot of each (edge, hinge node) and (triangle, corner) in its node's contiguous range of the scratch:
+// the node's (hinge, role) entries of the mesh's lists first, then its (triangle, corner) entries.
+template <class MemorySpace>
+void fill_membrane_slots(const MeshBuffers<MemorySpace>& mesh,
+                         const Kokkos::View<int* [4], Kokkos::LayoutRight, MemorySpace>& edge_slot,
+                         const Kokkos::View<int* [3], Kokkos::LayoutRight, MemorySpace>& tri_slot) {
+  const auto hinge_offsets = mesh.node_hinge_offsets;
+  const auto roles = mesh.node_hinge_roles;
+  const auto tri_offsets = mesh.node_tri_offsets;
+  const auto corners = mesh.node_tri_corners;
+  Kokkos::parallel_for(
+      "dcm::membrane::slots", Kokkos::RangePolicy<typename MemorySpace::execution_space>(0, mesh.n_nodes),
+      KOKKOS_LAMBDA(const int i) {
+        for (int s = hinge_offsets(i); s < hinge_offsets(i + 1); ++s)
+          edge_slot(roles(s) / 4, roles(s) % 4) = s + tri_offsets(i);
+        for (int s = tri_offsets(i); s < tri_offsets(i + 1); ++s)
+          tri_slot(corners(s) / 3, corners(s) % 3) = s + hinge_offsets(i + 1);
+      });
+}
+
+// Scratch of the passes (allocated once per mesh). The passes write each node's share of a triangle or edge
+// into a slot of the node's own contiguous range (fill_membrane_slots()), so that the gather reads one
+// contiguous range per node and no pass needs atomics.
 template <class MemorySpace>
 struct MembraneScratch {
-  Kokkos::View<double* [3][3], Kokkos::LayoutRight, MemorySpace> corner_force;  // per triangle corner (N)
-  Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> bond_u;               // U'(d)/d per edge (N/m)
+  Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace> slot_force;  // per (node, entry) (N)
+  Kokkos::View<int* [4], Kokkos::LayoutRight, MemorySpace> edge_slot;      // slot of (edge, hinge node)
+  Kokkos::View<int* [3], Kokkos::LayoutRight, MemorySpace> tri_slot;       // slot of (triangle, corner)
   MembraneScratch() = default;
   explicit MembraneScratch(const MeshBuffers<MemorySpace>& mesh)
-      : corner_force("dcm::membrane::corner_force", mesh.n_tris),
-        bond_u("dcm::membrane::bond_u", mesh.n_hinges) {}
+      : slot_force("dcm::membrane::slot_force", 4 * mesh.n_hinges + 3 * mesh.n_tris),
+        edge_slot("dcm::membrane::edge_slot", mesh.n_hinges),
+        tri_slot("dcm::membrane::tri_slot", mesh.n_tris) {
+    fill_membrane_slots(mesh, edge_slot, tri_slot);
+  }
 };
 
 // Whether the mesh numbers bonds and hinges alike (bond e = (hinge(e, 0), hinge(e, 1))): the edge pass
@@ -90,7 +117,8 @@ void add_membrane_forces(const ExecutionSpace& space, const MeshBuffers<MemorySp
     const auto rest_area = area_rest.tri_area;
     const auto rest_cell_area = area_rest.cell_area;
     const auto rest_volume = volume_rest.cell_volume;
-    const auto out = scratch.corner_force;
+    const auto slot = scratch.tri_slot;
+    const auto out = scratch.slot_force;
     Kokkos::parallel_for(
         "dcm::membrane::triangles", Kokkos::RangePolicy<ExecutionSpace>(space, 0, (n + W - 1) / W),
         KOKKOS_LAMBDA(const int batch) {
@@ -126,7 +154,7 @@ void add_membrane_forces(const ExecutionSpace& space, const MeshBuffers<MemorySp
           for (int l = 0; l < W; ++l)
             if (batch * W + l < n)
               for (int v = 0; v < 3; ++v)
-                for (int d = 0; d < 3; ++d) out(batch * W + l, v, d) = f[v][d][l];
+                for (int d = 0; d < 3; ++d) out(slot(batch * W + l, v), d) = f[v][d][l];
         });
   }
   // 2. Edge pass.
@@ -139,7 +167,8 @@ void add_membrane_forces(const ExecutionSpace& space, const MeshBuffers<MemorySp
     const auto grad = hinge_rest.hinge_grad;
     const auto moment = hinge_rest.hinge_moment;
     const auto cos_delta = hinge_rest.hinge_cos_delta;
-    const auto bond_u = scratch.bond_u;
+    const auto slot = scratch.edge_slot;
+    const auto out = scratch.slot_force;
     Kokkos::parallel_for(
         "dcm::membrane::edges", Kokkos::RangePolicy<ExecutionSpace>(space, 0, (n + W - 1) / W),
         KOKKOS_LAMBDA(const int batch) {
@@ -157,7 +186,7 @@ void add_membrane_forces(const ExecutionSpace& space, const MeshBuffers<MemorySp
             ks[l] = bp.k_s;
             xm2[l] = bp.x_max * bp.x_max;
           }
-          double g[4][3][W], m[W], cd[W], u[W];
+          double g[4][3][W], m[W], cd[W], fb[3][W];
           int bond_bad[W];
           for (int l = 0; l < W; ++l) {
             const double ex = p[1][0][l] - p[0][0][l], ey = p[1][1][l] - p[0][1][l],
@@ -184,7 +213,10 @@ void add_membrane_forces(const ExecutionSpace& space, const MeshBuffers<MemorySp
             const double inv_n1 = q * len * gap * n2s, inv_n2 = q * len * gap * n1s;
             // U'(d)/d = k_s d_max^2 / (d_max^2 - d^2) - k_c / d^3, k_c = k_s d*^3 / (1 - 1/x_max^2) (eq. 24)
             const double k_c = ks[l] * dr * dr * dr / (1 - 1 / xm2[l]);
-            u[l] = bond_ok ? ks[l] * d_max2 * inv_gap - k_c * inv_len * inv_len * inv_len : 0.0;
+            const double u = bond_ok ? ks[l] * d_max2 * inv_gap - k_c * inv_len * inv_len * inv_len : 0.0;
+            fb[0][l] = u * ex;  // the bond's force on i: U'(d)/d (x_j - x_i); on j the opposite
+            fb[1][l] = u * ey;
+            fb[2][l] = u * ez;
             bond_bad[l] = bond_ok ? 0 : 1;
             // Hinge (eq. 26), kernels/bending.hpp's hinge_trig_gradient() with these reciprocals.
             const double inv = root * inv_n1 * inv_n2 * inv_len;  // 1 / (|e| |n1| |n2|)
@@ -216,47 +248,32 @@ void add_membrane_forces(const ExecutionSpace& space, const MeshBuffers<MemorySp
             if (bond_bad[l]) Kokkos::atomic_compare_exchange(&overstretched(), -1, e);
             moment(e) = m[l];
             cos_delta(e) = cd[l];
-            bond_u(e) = u[l];
             for (int v = 0; v < 4; ++v)
               for (int d = 0; d < 3; ++d) grad(e, v, d) = g[v][d][l];
+            const int s0 = slot(e, 0), s1 = slot(e, 1), s2 = slot(e, 2), s3 = slot(e, 3);
+            for (int d = 0; d < 3; ++d) {
+              out(s0, d) = m[l] * g[0][d][l] + fb[d][l];
+              out(s1, d) = m[l] * g[1][d][l] - fb[d][l];
+              out(s2, d) = m[l] * g[2][d][l];
+              out(s3, d) = m[l] * g[3][d][l];
+            }
           }
         });
   }
-  // 3. Node gather.
+  // 3. Node gather: the node's slots, contiguous.
   {
-    const auto hinge = mesh.hinge;
     const auto hinge_offsets = mesh.node_hinge_offsets;
-    const auto roles = mesh.node_hinge_roles;
     const auto tri_offsets = mesh.node_tri_offsets;
-    const auto corners = mesh.node_tri_corners;
-    const auto grad = hinge_rest.hinge_grad;
-    const auto moment = hinge_rest.hinge_moment;
-    const auto bond_u = scratch.bond_u;
-    const auto corner_force = scratch.corner_force;
+    const auto in = scratch.slot_force;
     Kokkos::parallel_for(
         "dcm::membrane::gather", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
         KOKKOS_LAMBDA(const int i) {
-          const double p0 = x(i, 0), p1 = x(i, 1), p2 = x(i, 2);
           double f0 = 0, f1 = 0, f2 = 0;
-          for (int s = hinge_offsets(i); s < hinge_offsets(i + 1); ++s) {
-            const int h = roles(s) / 4, a = roles(s) % 4;
-            const double m = moment(h);
-            f0 += m * grad(h, a, 0);
-            f1 += m * grad(h, a, 1);
-            f2 += m * grad(h, a, 2);
-            if (a < 2) {  // the edge's bond: F_i = U'(d)/d (x_j - x_i)
-              const int j = hinge(h, 1 - a);
-              const double u = bond_u(h);
-              f0 += u * (x(j, 0) - p0);
-              f1 += u * (x(j, 1) - p1);
-              f2 += u * (x(j, 2) - p2);
-            }
-          }
-          for (int s = tri_offsets(i); s < tri_offsets(i + 1); ++s) {
-            const int t = corners(s) / 3, c = corners(s) % 3;
-            f0 += corner_force(t, c, 0);
-            f1 += corner_force(t, c, 1);
-            f2 += corner_force(t, c, 2);
+          for (int s = hinge_offsets(i) + tri_offsets(i); s < hinge_offsets(i + 1) + tri_offsets(i + 1);
+               ++s) {
+            f0 += in(s, 0);
+            f1 += in(s, 1);
+            f2 += in(s, 2);
           }
           force(i, 0) += f0;
           force(i, 1) += f1;
