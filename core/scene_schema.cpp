@@ -173,6 +173,10 @@ std::vector<ParamSpec> make_schema() {
       real_key("solver.mg_damping", "0.6", 0, 0.66, kExcl, "",
                "multigrid: the smoother's damping ω (ω λ_max(D⁻¹A) < 2 keeps the V-cycle positive definite, "
                "and λ_max ≤ 3 on the finest level)"),
+      string_key("solver.mg_bending", "auto", {"auto", "on", "off"},
+                 "multigrid: the implicit bending stiffness in the preconditioner (a positive semi-definite "
+                 "approximation on the bond pattern; the CG's operator stays exact): auto = on for cells of "
+                 "10242 nodes and more, where it keeps the iterations per step flat"),
       bool_key(
           "solver.implicit_bending", "true",
           "bending's Gauss–Newton stiffness in the velocity solve: stable at the paper's Δt on fine meshes"),

@@ -90,7 +90,8 @@ inline std::string batch_mismatch(const MechanicsParams& a, const MechanicsParam
        on(a.dashpot) != on(b.dashpot) || on(a.dashpot_transverse) != on(b.dashpot_transverse)},
       {"the curvature clamp h_min", a.h_min != b.h_min},
       {"the preconditioner (multigrid, its sweeps and damping)",
-       a.multigrid != b.multigrid || a.mg.sweeps != b.mg.sweeps || a.mg.damping != b.mg.damping},
+       a.multigrid != b.multigrid || a.mg.sweeps != b.mg.sweeps || a.mg.damping != b.mg.damping ||
+           a.mg.bending_min_nodes != b.mg.bending_min_nodes},
       {"the implicit terms", a.implicit_bonds != b.implicit_bonds ||
                                  a.implicit_bending != b.implicit_bending ||
                                  a.implicit_tension != b.implicit_tension},
@@ -412,23 +413,24 @@ class CortexModel {
     }
     update_friction(space_, mesh_, friction_, !multigrid_.has_value());  // the multigrid inverts its own
     const bool implicit_tension = dt > 0 && tension_stiffness_.has_value();
+    const bool implicit_bending = dt > 0 && bending_stiffness_.has_value();
+    if (implicit_bending)
+      update_bending_stiffness(k_b_.host, dt_cells, *bending_stiffness_);  // ∇θ from compute_forces()
     if (implicit_tension)
       update_tension_stiffness(space_, mesh_, geo_, *area_, k_area_local_.table(), k_area_global_.table(),
                                dt_.table(), *tension_stiffness_);
     // The multigrid's fine level holds Γ, the implicit bonds and the implicit tension (same sparsity).
     if (multigrid_) {
       try {
-        update_multigrid(space_, mesh_, friction_, *multigrid_,
-                         implicit_tension ? &*tension_stiffness_ : nullptr);
+        update_multigrid(
+            space_, mesh_, friction_, *multigrid_, implicit_tension ? &*tension_stiffness_ : nullptr,
+            implicit_bending ? &*hinges_ : nullptr, implicit_bending ? &*bending_stiffness_ : nullptr);
       } catch (const NumericalError& e) {  // the coarse level knows the cell; the force shows where it starts
         throw NumericalError(std::string(e.what()) + "; the largest force is at node " +
                              std::to_string(largest_force_node()));
       }
     }
     const bool implicit = dt > 0 && global_.has_value();
-    const bool implicit_bending = dt > 0 && bending_stiffness_.has_value();
-    if (implicit_bending)
-      update_bending_stiffness(k_b_.host, dt_cells, *bending_stiffness_);  // ∇θ from compute_forces()
     if (implicit)
       update_global_stiffness(space_, mesh_, geo_, area_ ? area_->cell_area : volume_->cell_volume,
                               volume_ ? volume_->cell_volume : area_->cell_area, k_area_global_.table(),
@@ -448,7 +450,7 @@ class CortexModel {
         // no mask, no per-row check).
         [&](const Vector& in, const Vector& out) {
           if (multigrid_) {  // its level 0 holds Γ, the implicit bonds and tension: one block product
-            block_csr_multiply(space_, multigrid_->levels[0].a, in, out, active);
+            block_csr_multiply(space_, multigrid_->fine_operator(), in, out, active);
           } else {
             apply_friction(space_, mesh_, friction_, in, out, active);
             if (implicit_tension)

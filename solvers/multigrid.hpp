@@ -3,8 +3,10 @@
 // subdivision hierarchy (solvers/multigrid_setup.hpp).
 //   make_multigrid(cells, mesh)          once per mesh: P, R = Pᵀ, patterns, Galerkin recipes
 //   update_multigrid(space, mesh, op, mg) once per step, after update_friction(): A_0 = Γ assembled into
-//                                         3×3 blocks from the cached n̂_b, A_{l+1} = Pᵀ A_l P, block
-//                                         inverses, the coarsest level (12 nodes per cell) inverted densely
+//                                         3×3 blocks from the cached n̂_b (+ an approximation of the
+//                                         implicit bending, mg_detail::update_bending_axes), A_{l+1} = Pᵀ A_l
+//                                         P, block inverses, the coarsest level (12 nodes per cell) inverted
+//                                         densely
 //   apply_multigrid(space, mg, r, z)     z = M⁻¹ r, one V-cycle; the PCG precondition(r, z) callable
 // Smoother: ν sweeps of damped block-Jacobi x ← x + ω D⁻¹ (b − A x) before and the same ν after the
 // coarse correction. D is symmetric, so the post-smoother is the adjoint of the pre-smoother and the
@@ -24,6 +26,8 @@
 #include "core/buffers.hpp"
 #include "core/errors.hpp"
 #include "core/host_copy.hpp"
+#include "kernels/bending.hpp"
+#include "solvers/bending_stiffness.hpp"
 #include "solvers/block_sparse.hpp"
 #include "solvers/friction_operator.hpp"
 #include "solvers/multigrid_setup.hpp"
@@ -34,6 +38,12 @@ namespace dcm {
 struct MultigridSettings {
   int sweeps = 2;        // ν pre- and ν post-smoothing sweeps
   double damping = 0.6;  // ω
+  // The implicit bending stiffness (solvers/bending_stiffness.hpp) in the preconditioner when some cell has
+  // at least this many nodes: level 0 then holds a positive semi-definite approximation of it on the bond
+  // pattern (docs/model/solver.md, "Bending in the preconditioner"); the operator the CG applies stays
+  // exact. On coarser meshes the dashpots dominate the bending and it would cost without saving iterations.
+  static constexpr int kBendingAuto = 10242;
+  int bending_min_nodes = kBendingAuto;
 };
 
 template <class MemorySpace>
@@ -65,9 +75,25 @@ struct Multigrid {
   // Level 0: per slot (i, j) the triangle corners (t, c_i, c_j) with tri(t, c_i) = i, tri(t, c_j) = j, packed
   // as 9 t + 3 c_i + c_j, in the order of i's triangle corners (the implicit tension blocks; topology only).
   View<int*> fine_slot_tension_offsets, fine_slot_tension;
+  // Bending in the preconditioner (settings.bending and a mesh with hinges): per slot (i, j) the hinge roles
+  // (h, a, b) with hinge(h, a) = i, hinge(h, b) = j, packed as 16 h + 4 a + b, in hinge order; the wings'
+  // cross pair (2, 3) is left out and each wing's diagonal entry listed twice (the approximation stays
+  // positive semi-definite). bending_axis: per hinge N̂ and s α_a (a = 0..3) of the step.
+  View<int*> fine_slot_bending_offsets, fine_slot_bending;
+  View<double* [7]> bending_axis;
+  // Level 0's blocks without the bending (the CG's operator) while level 0 holds it; else empty.
+  View<double* [6]> operator_values;
+  bool bending_in_level0 = false;  // of the last update_multigrid()
   std::vector<MultigridLevel<MemorySpace>> levels;
   View<double***> coarse_inverse;  // per cell, the inverse of the coarsest operator (36 × 36)
   typename View<double***>::host_mirror_type coarse_inverse_host;
+  // The operator's level-0 blocks (Γ, implicit bonds and tension; without the bending the preconditioner
+  // may hold): what the CG applies.
+  BlockCsr<MemorySpace> fine_operator() const {
+    BlockCsr<MemorySpace> a = levels[0].a;
+    if (bending_in_level0) a.values = operator_values;
+    return a;
+  }
 };
 
 namespace mg_detail {
@@ -202,6 +228,34 @@ Multigrid<MemorySpace> make_multigrid(const std::vector<HostCell>& cells,
     mg.fine_slot_tension_offsets = mg_detail::upload_vector<IV>("fine_slot_tension_offsets", offsets);
     mg.fine_slot_tension = mg_detail::upload_vector<IV>("fine_slot_tension", entries);
   }
+  int largest_cell = 0;
+  for (const HostCell& c : cells)
+    largest_cell = std::max(largest_cell, static_cast<int>(c.mesh.nodes.size()));
+  if (largest_cell >= settings.bending_min_nodes && mesh.n_hinges > 0) {  // the bending blocks of each slot
+    const auto hinge = to_host_vector(mesh.hinge);
+    std::vector<std::vector<int>> per_slot(h.fine.cols.size());
+    for (int e = 0; e < mesh.n_hinges; ++e)
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) {
+          if ((a == 2 && b == 3) || (a == 3 && b == 2)) continue;  // the wings are not bond neighbours
+          const int i = hinge[4 * e + a], j = hinge[4 * e + b];
+          const int sl = h.fine.slot(i, j);
+          if (sl >= h.fine.offsets[i + 1] || h.fine.cols[sl] != j)
+            throw std::logic_error("multigrid: a hinge couples nodes that are not bond neighbours");
+          per_slot[sl].push_back(16 * e + 4 * a + b);
+          if (a == b && a >= 2) per_slot[sl].push_back(16 * e + 4 * a + b);
+        }
+    std::vector<int> offsets(1, 0), entries;
+    for (const auto& v : per_slot) {
+      entries.insert(entries.end(), v.begin(), v.end());
+      offsets.push_back(static_cast<int>(entries.size()));
+    }
+    mg.fine_slot_bending_offsets = mg_detail::upload_vector<IV>("fine_slot_bending_offsets", offsets);
+    mg.fine_slot_bending = mg_detail::upload_vector<IV>("fine_slot_bending", entries);
+    mg.bending_axis = typename M::template View<double* [7]>("dcm::mg::bending_axis", mesh.n_hinges);
+    mg.operator_values = typename M::template View<double* [6]>(
+        Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::mg::operator_values"), mg.levels[0].a.nnz);
+  }
   if (h.available) {
     mg.coarse_inverse = typename M::template View<double***>("dcm::mg::coarse_inverse", mg.n_cells,
                                                              M::kCoarseDofs, M::kCoarseDofs);
@@ -210,15 +264,60 @@ Multigrid<MemorySpace> make_multigrid(const std::vector<HostCell>& cells,
   return mg;
 }
 
+namespace mg_detail {
+
+// The per-hinge factors of level 0's bending blocks (update_multigrid adds them). Level 0 = the operator's
+// blocks + a positive semi-definite approximation of the implicit bending
+// Δt k_b max(cos(θ − θ*), 0) ∇θ ∇θᵀ per hinge (solvers/bending_stiffness.hpp) on the bond pattern: each
+// role's gradient ∇_a θ is replaced by its component α_a N̂ along the hinge's normal N̂ (the direction of
+// ∇_k θ + ∇_l θ; exact for a flat hinge, where all four gradients are normal), and the wings' cross block
+// s α_k α_l N̂N̂ᵀ, which is not on the pattern, by s (α_k² + α_l²) N̂N̂ᵀ on their diagonals: per hinge
+// s [(Σ_a α_a N̂·u_a)² + (α_k N̂·u_k − α_l N̂·u_l)²] ≥ 0 for every u. Every block is a multiple of N̂N̂ᵀ.
+template <class ExecutionSpace, class MemorySpace>
+void update_bending_axes(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                         const HingeRest<MemorySpace>& hinges, const BendingStiffness<MemorySpace>& bending,
+                         const Multigrid<MemorySpace>& mg) {
+  const auto g = hinges.hinge_grad;
+  const auto cos_delta = hinges.hinge_cos_delta;
+  const auto dt_k_b = bending.dt_k_b;
+  const auto hinge_cell = mesh.hinge_cell;
+  const auto axis = mg.bending_axis;
+  Kokkos::parallel_for(
+      "dcm::mg::bending_axis", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_hinges),
+      KOKKOS_LAMBDA(const int h) {
+        const Real3 wings{g(h, 2, 0) + g(h, 3, 0), g(h, 2, 1) + g(h, 3, 1), g(h, 2, 2) + g(h, 3, 2)};
+        const double len = norm(wings);
+        const Real3 n = len > 0 ? (1.0 / len) * wings : Real3{0, 0, 0};
+        const double s = math::sqrt(dt_k_b(hinge_cell(h)) * math::max(cos_delta(h), 0.0));
+        axis(h, 0) = n.x;
+        axis(h, 1) = n.y;
+        axis(h, 2) = n.z;
+        for (int a = 0; a < 4; ++a)
+          axis(h, 3 + a) = s * (g(h, a, 0) * n.x + g(h, a, 1) * n.y + g(h, a, 2) * n.z);
+      });
+}
+
+}  // namespace mg_detail
+
 // Numeric set-up, once per step after update_friction(space, mesh, op).
 template <class ExecutionSpace, class MemorySpace>
 void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                       const FrictionOperator<MemorySpace>& op, Multigrid<MemorySpace>& mg,
-                      const TensionStiffness<MemorySpace>* tension = nullptr) {
+                      const TensionStiffness<MemorySpace>* tension = nullptr,
+                      const HingeRest<MemorySpace>* hinges = nullptr,
+                      const BendingStiffness<MemorySpace>* bending = nullptr) {
+  mg.bending_in_level0 = hinges != nullptr && bending != nullptr && mg.operator_values.extent(0) > 0;
   {  // level 0: Γ's blocks, ζ_i I + Σ_b c n̂n̂ᵀ on the diagonal, −c n̂n̂ᵀ for each bond
     const BlockCsr<MemorySpace>& a = mg.levels[0].a;
     const auto off = a.row_offsets;
     const auto val = a.values;
+    const bool with_bending = mg.bending_in_level0;
+    if (with_bending) mg_detail::update_bending_axes(space, mesh, *hinges, *bending, mg);
+    const auto op_val = mg.operator_values;
+    const auto bend_off = mg.fine_slot_bending_offsets;
+    const auto bend = mg.fine_slot_bending;
+    const auto axis = mg.bending_axis;
+    const auto out = with_bending ? op_val : val;  // assemble_fine: the operator's blocks
     const auto slot_bond = mg.fine_slot_bond;
     const auto node_off = mesh.node_bond_offsets;
     const auto node_bonds = mesh.node_bonds;
@@ -261,9 +360,22 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
                                  t_edge(t, ci, 2) * t_edge(t, cj, 2);
                 add_dashpot_block(load3(t_normal, t), w, 0.0, 1.0, blk);  // w n_t n_tᵀ
               }
-            for (int k = 0; k < 6; ++k) val(s, k) = blk[k];
+            for (int k = 0; k < 6; ++k) out(s, k) = blk[k];
           }
         });
+    if (with_bending)  // the preconditioner's level 0: the operator's blocks + the bending's
+      Kokkos::parallel_for(
+          "dcm::mg::add_bending", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.nnz),
+          KOKKOS_LAMBDA(const int s) {
+            double blk[6];
+            for (int k = 0; k < 6; ++k) blk[k] = op_val(s, k);
+            for (int q = bend_off(s); q < bend_off(s + 1); ++q) {
+              const int h = bend(q) / 16, ra = bend(q) / 4 % 4, rb = bend(q) % 4;
+              add_dashpot_block(Real3{axis(h, 0), axis(h, 1), axis(h, 2)}, axis(h, 3 + ra) * axis(h, 3 + rb),
+                                0.0, 1.0, blk);  // s α_a α_b N̂N̂ᵀ
+            }
+            for (int k = 0; k < 6; ++k) val(s, k) = blk[k];
+          });
     block_csr_invert_diagonal(space, a);
   }
   for (std::size_t l = 1; l < mg.levels.size(); ++l) {  // A_l = Pᵀ A_{l−1} P
