@@ -152,9 +152,12 @@ class TimeStepper {
     if (settings_.adaptive) {
       std::vector<char> checking(n_, 0);
       for (int c = 0; c < n_; ++c) checking[c] = stepping[c] && has_prev_[c];
+      std::vector<double> areas;  // the contact areas of the current positions, once summed
+      bool areas_current = false;
       while (any(checking)) {
         const std::vector<double> dv = velocity_change(model);
-        const std::vector<double> rho = contact_change(model);
+        const std::vector<double> rho = contact_change(model, areas);
+        areas_current = settings_.contact_change > 0;
         std::vector<char> rejected(n_, 0);
         for (int c = 0; c < n_; ++c) {
           if (!checking[c]) continue;
@@ -180,14 +183,15 @@ class TimeStepper {
         if (!any(rejected)) break;
         redo_previous_step(model, rejected);
         model.compute_forces();
+        areas_current = false;
         for (int c = 0; c < n_; ++c)
           if (rejected[c]) h_solved[c] = h_prev_[c];
         solve(model, cg, rejected, h_solved, rep);
       }
       if (settings_.contact_change > 0) {  // A_c at the start of this step, for the next step's check
-        const std::vector<double> a = cell_contact_areas(model);
+        if (!areas_current) areas = cell_contact_areas(model);
         for (int c = 0; c < n_; ++c)
-          if (stepping[c]) contact_prev_[c] = a[c];
+          if (stepping[c]) contact_prev_[c] = areas[c];
       }
       // The implicit terms depend on h: solve again where the step changed by more than 10%.
       std::vector<char> again(n_, 0);
@@ -319,10 +323,11 @@ class TimeStepper {
     return a;
   }
   // ρ_c = |A_c − A_c(start of the last step)| / max(A_c, Ā_t) per cell; zeros when the criterion is off.
-  std::vector<double> contact_change(const Model& model) const {
+  // a: receives the areas A_c (left as it is when the criterion is off).
+  std::vector<double> contact_change(const Model& model, std::vector<double>& a) const {
     std::vector<double> rho(n_, 0.0);
     if (!(settings_.contact_change > 0)) return rho;
-    const std::vector<double> a = cell_contact_areas(model);
+    a = cell_contact_areas(model);
     for (int c = 0; c < n_; ++c)  // < 0: no previous area (first step, older checkpoint), no check
       rho[c] =
           contact_prev_[c] < 0 ? 0.0 : std::fabs(a[c] - contact_prev_[c]) / std::max(a[c], contact_floor_[c]);
