@@ -42,7 +42,7 @@ struct MultigridSettings {
   // at least this many nodes: level 0 then holds a positive semi-definite approximation of it on the bond
   // pattern (docs/model/solver.md, "Bending in the preconditioner"); the operator the CG applies stays
   // exact. On coarser meshes the dashpots dominate the bending and it would cost without saving iterations.
-  static constexpr int kBendingAuto = 10242;
+  static constexpr int kBendingAuto = 40962;
   int bending_min_nodes = kBendingAuto;
 };
 
