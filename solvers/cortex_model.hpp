@@ -419,7 +419,8 @@ class CortexModel {
     if (implicit_tension)
       update_tension_stiffness(space_, mesh_, geo_, *area_, k_area_local_.table(), k_area_global_.table(),
                                dt_.table(), *tension_stiffness_);
-    // The multigrid's fine level holds Γ, the implicit bonds and the implicit tension (same sparsity).
+    // The multigrid's fine level holds Γ, the implicit bonds and the implicit tension (same sparsity), and on
+    // fine meshes an approximation of the implicit bending for the preconditioner only (fine_operator()).
     if (multigrid_) {
       try {
         update_multigrid(
@@ -449,7 +450,7 @@ class CortexModel {
         // Only the cells still iterating (a batch: the others have converged or are not stepping; one cell:
         // no mask, no per-row check).
         [&](const Vector& in, const Vector& out) {
-          if (multigrid_) {  // its level 0 holds Γ, the implicit bonds and tension: one block product
+          if (multigrid_) {  // Γ, the implicit bonds and tension as one block product
             block_csr_multiply(space_, multigrid_->fine_operator(), in, out, active);
           } else {
             apply_friction(space_, mesh_, friction_, in, out, active);

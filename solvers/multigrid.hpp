@@ -75,10 +75,10 @@ struct Multigrid {
   // Level 0: per slot (i, j) the triangle corners (t, c_i, c_j) with tri(t, c_i) = i, tri(t, c_j) = j, packed
   // as 9 t + 3 c_i + c_j, in the order of i's triangle corners (the implicit tension blocks; topology only).
   View<int*> fine_slot_tension_offsets, fine_slot_tension;
-  // Bending in the preconditioner (settings.bending and a mesh with hinges): per slot (i, j) the hinge roles
-  // (h, a, b) with hinge(h, a) = i, hinge(h, b) = j, packed as 16 h + 4 a + b, in hinge order; the wings'
-  // cross pair (2, 3) is left out and each wing's diagonal entry listed twice (the approximation stays
-  // positive semi-definite). bending_axis: per hinge N̂ and s α_a (a = 0..3) of the step.
+  // Bending in the preconditioner (a cell of settings.bending_min_nodes or more, a mesh with hinges): per
+  // slot (i, j) the hinge roles (h, a, b) with hinge(h, a) = i, hinge(h, b) = j, packed as 16 h + 4 a + b, in
+  // hinge order; the wings' cross pair (2, 3) is left out and each wing's diagonal entry listed twice (the
+  // approximation stays positive semi-definite). bending_axis: per hinge N̂ and √s α_a (a = 0..3) of the step.
   View<int*> fine_slot_bending_offsets, fine_slot_bending;
   View<double* [7]> bending_axis;
   // Level 0's blocks without the bending (the CG's operator) while level 0 holds it; else empty.

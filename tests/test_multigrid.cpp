@@ -25,6 +25,19 @@ double dot_host(const std::vector<double>& a, const std::vector<double>& b) {
   return s;
 }
 
+// A block matrix (symmetric 3×3 blocks) as a dense matrix.
+Eigen::MatrixXd dense_blocks(const BlockCsr<Mem>& a) {
+  const auto off = to_host_vector(a.row_offsets), cols = to_host_vector(a.cols);
+  const auto v = to_host_vector(a.values);
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(3 * a.n_rows, 3 * a.n_rows);
+  for (int i = 0; i < a.n_rows; ++i)
+    for (int q = off[i]; q < off[i + 1]; ++q) {
+      const double* b = &v[6 * q];
+      m.block<3, 3>(3 * i, 3 * cols[q]) << b[0], b[3], b[4], b[3], b[1], b[5], b[4], b[5], b[2];
+    }
+  return m;
+}
+
 struct Preconditioned : FrictionSetup {
   Multigrid<Mem> mg;
   RigidModes<Mem> rigid;
@@ -106,18 +119,7 @@ TEST(Multigrid, RestrictionIsTheTransposeOfProlongation) {
 TEST(Multigrid, CoarseOperatorsAreGalerkinProducts) {
   const Preconditioned s({2});
   const Eigen::MatrixXd a0 = s.assemble();
-  auto dense = [](const BlockCsr<Mem>& a) {
-    const auto off = to_host_vector(a.row_offsets), cols = to_host_vector(a.cols);
-    const auto v = to_host_vector(a.values);
-    Eigen::MatrixXd m = Eigen::MatrixXd::Zero(3 * a.n_rows, 3 * a.n_rows);
-    for (int i = 0; i < a.n_rows; ++i)
-      for (int q = off[i]; q < off[i + 1]; ++q) {
-        const double* b = &v[6 * q];
-        m.block<3, 3>(3 * i, 3 * cols[q]) << b[0], b[3], b[4], b[3], b[1], b[5], b[4], b[5], b[2];
-      }
-    return m;
-  };
-  Eigen::MatrixXd fine = dense(s.mg.levels[0].a);
+  Eigen::MatrixXd fine = dense_blocks(s.mg.levels[0].a);
   EXPECT_LT((fine - a0).norm(), 1e-12 * a0.norm());
   for (std::size_t l = 0; l + 1 < s.mg.levels.size(); ++l) {
     const int nf = s.mg.levels[l].a.n_rows, nc = s.mg.levels[l + 1].a.n_rows;
@@ -129,7 +131,7 @@ TEST(Multigrid, CoarseOperatorsAreGalerkinProducts) {
         pm(3 * i + d, 3 * p[2 * i + 1] + d) += 0.5;
       }
     const Eigen::MatrixXd expected = pm.transpose() * fine * pm;
-    const Eigen::MatrixXd coarse = dense(s.mg.levels[l + 1].a);
+    const Eigen::MatrixXd coarse = dense_blocks(s.mg.levels[l + 1].a);
     EXPECT_LT((coarse - expected).norm(), 1e-12 * expected.norm()) << "level " << l + 1;
     fine = coarse;
   }
@@ -171,14 +173,7 @@ TEST(Multigrid, FineLevelHoldsTheImplicitTension) {
   Eigen::VectorXd shift(3 * n);
   for (int i = 0; i < n; ++i) shift.segment<3>(3 * i) = Eigen::Vector3d(0.3, -0.2, 0.9);
   EXPECT_LT((k * shift).norm(), 1e-12 * k.norm() * shift.norm());
-  const auto off = to_host_vector(s.mg.levels[0].a.row_offsets), cols = to_host_vector(s.mg.levels[0].a.cols);
-  const auto v = to_host_vector(s.mg.levels[0].a.values);
-  Eigen::MatrixXd fine = Eigen::MatrixXd::Zero(3 * n, 3 * n);
-  for (int i = 0; i < n; ++i)
-    for (int q = off[i]; q < off[i + 1]; ++q) {
-      const double* b = &v[6 * q];
-      fine.block<3, 3>(3 * i, 3 * cols[q]) << b[0], b[3], b[4], b[3], b[1], b[5], b[4], b[5], b[2];
-    }
+  const Eigen::MatrixXd fine = dense_blocks(s.mg.levels[0].a);
   const Eigen::MatrixXd expected = s.assemble() + k;
   EXPECT_LT((fine - expected).norm(), 1e-12 * expected.norm());
 }
@@ -200,18 +195,6 @@ struct WithBending : Preconditioned {
     ms.bending_min_nodes = min_nodes;
     mg = make_multigrid(cells, mesh, ms);
     update_multigrid(Exec(), mesh, op, mg, kNoTension, &hinges, &bs);
-  }
-  Eigen::MatrixXd dense_blocks(const BlockCsr<Mem>& a) const {
-    const int n = mesh.n_nodes;
-    const auto off = to_host_vector(a.row_offsets), cols = to_host_vector(a.cols);
-    const auto v = to_host_vector(a.values);
-    Eigen::MatrixXd m = Eigen::MatrixXd::Zero(3 * n, 3 * n);
-    for (int i = 0; i < n; ++i)
-      for (int q = off[i]; q < off[i + 1]; ++q) {
-        const double* b = &v[6 * q];
-        m.block<3, 3>(3 * i, 3 * cols[q]) << b[0], b[3], b[4], b[3], b[1], b[5], b[4], b[5], b[2];
-      }
-    return m;
   }
   // Γ + Δt K_bend, exactly, column by column from the matrix-free products.
   Eigen::MatrixXd exact_operator() const {
@@ -250,7 +233,7 @@ TEST(Multigrid, BendingInTheFineLevelIsTheStatedPositiveApproximation) {
   WithBending s(2, dt_k_b, 0);
   ASSERT_TRUE(s.mg.bending_in_level0);
   const Eigen::MatrixXd gamma = s.assemble();
-  const Eigen::MatrixXd op = s.dense_blocks(s.mg.fine_operator());
+  const Eigen::MatrixXd op = dense_blocks(s.mg.fine_operator());
   EXPECT_LT((op - gamma).norm(), 1e-12 * gamma.norm()) << "the CG's operator stays Γ";
   // The approximation from its definition, on the host.
   const int n = s.mesh.n_nodes;
@@ -269,7 +252,7 @@ TEST(Multigrid, BendingInTheFineLevelIsTheStatedPositiveApproximation) {
     const double w = dt_k_b * std::max(cd[h], 0.0);
     b += w * (whole * whole.transpose() + wings * wings.transpose());
   }
-  const Eigen::MatrixXd level0 = s.dense_blocks(s.mg.levels[0].a);
+  const Eigen::MatrixXd level0 = dense_blocks(s.mg.levels[0].a);
   ASSERT_GT(b.norm(), 1e-3 * gamma.norm()) << "the bending is not negligible in this test";
   EXPECT_LT((level0 - gamma - b).norm(), 1e-12 * level0.norm());
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(level0 - gamma, Eigen::EigenvaluesOnly);
@@ -285,7 +268,7 @@ TEST(Multigrid, BendingInTheFineLevelIsTheStatedPositiveApproximation) {
   // Below bending_min_nodes the level is Γ alone.
   WithBending off(2, dt_k_b, 10242);
   EXPECT_FALSE(off.mg.bending_in_level0);
-  EXPECT_LT((off.dense_blocks(off.mg.levels[0].a) - gamma).norm(), 1e-12 * gamma.norm());
+  EXPECT_LT((dense_blocks(off.mg.levels[0].a) - gamma).norm(), 1e-12 * gamma.norm());
 }
 
 // Where the bending stiffness reaches the dashpots' soft (normal) modes, the preconditioner with it needs
