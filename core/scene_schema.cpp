@@ -122,6 +122,11 @@ std::vector<ParamSpec> make_schema() {
       int_choice_key("contact.quadrature_points", "0", {"0", "1", "3", "7", "16"},
                      "pressure integration over a triangle: 0 = exact in r (dcm's default), 1/3/7/16 = the "
                      "paper's point rules (eq. 18)"),
+      string_key("contact.quadrature_area", "projected", {"projected", "triangle"},
+                 "the area the point rules' weights multiply (quadrature_points > 0): projected = the "
+                 "triangle's area projected on the plane (dcm: the projections tile the plane); triangle = "
+                 "the triangle's own area A_t (the paper's eq. 16 read literally: a tilted triangle counts "
+                 "1/cos(tilt) times)"),
       real_key("contact.start_gap_m", "10e-9", -1e-6, 1e-5, kIncl, "m",
                "spread: the cell's lowest node starts this far above the plane (below contact.h0_m, or "
                "higher with gravity on; negative: pressed into the plane)"),

@@ -146,6 +146,45 @@ TEST(PlaneContact, SmallContactsStayAccurateWithExactIntegration) {
   }
 }
 
+// contact.quadrature_area: the paper's point rules weight each triangle by its projected area (dcm) or by its
+// own area (eq. 16 read literally). On a rigid sphere pressed to a/R = 0.5 every loaded triangle's load and
+// contact area differ between the two by exactly A_t / A_proj = 1/|n_z|, which reaches 1.15 at the rim
+// (30° tilt); the projected weights are the ones that match the continuum MD load.
+TEST(PlaneContact, PointRulesWeightTheProjectedOrTheTriangleArea) {
+  HostMesh m = make_icosphere(4, kR);
+  const double a = 0.5 * kR;
+  for (auto& x : m.nodes) x[2] += std::sqrt(kR * kR - a * a);
+  PlaneContactParams prm;
+  prm.material = material_for_lambda(0.1);
+  prm.quadrature_points = 16;
+  const MeshContact projected = contact_of(m, prm);
+  prm.projected_area = false;
+  const MeshContact own = contact_of(m, prm);
+  int loaded = 0;
+  double largest_ratio = 0;
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    if (projected.load[t] == 0) {
+      EXPECT_EQ(own.load[t], 0.0);
+      continue;
+    }
+    const auto& p0 = m.nodes[m.triangles[t][0]];
+    const auto& p1 = m.nodes[m.triangles[t][1]];
+    const auto& p2 = m.nodes[m.triangles[t][2]];
+    const double ux = p1[0] - p0[0], uy = p1[1] - p0[1], uz = p1[2] - p0[2];
+    const double vx = p2[0] - p0[0], vy = p2[1] - p0[1], vz = p2[2] - p0[2];
+    const double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
+    const double ratio = std::sqrt(nx * nx + ny * ny + nz * nz) / std::fabs(nz);  // A_t / A_proj
+    EXPECT_NEAR(own.load[t] / projected.load[t], ratio, 1e-9 * ratio) << "triangle " << t;
+    if (projected.area[t] > 0) EXPECT_NEAR(own.area[t] / projected.area[t], ratio, 1e-9 * ratio);
+    largest_ratio = std::fmax(largest_ratio, ratio);
+    ++loaded;
+  }
+  EXPECT_GT(loaded, 100);
+  EXPECT_GT(largest_ratio, 1.1);
+  const MdState exact = md_state_from_radius(a, kR, prm.material);
+  EXPECT_LT(std::fabs(projected.load_sum - exact.P), std::fabs(own.load_sum - exact.P));
+}
+
 // The radial integrals G(ρ) = ∫ p r dr and H(ρ) = ∫ p r² dr of kernels/polar_contact_integral.hpp against
 // a composite Simpson rule on 2e5 intervals per zone (split at a and c), from DMT-like to JKR-like λ (at
 // λ = 100 the Dugdale boundary layer at r = a is thinner than Simpson's step: 2.5e-5 apart there).

@@ -45,6 +45,7 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
     p.contact.material = md_material(scene.get_real("cortex.E_Pa"), scene.get_real("cortex.nu"),
                                      scene.get_real("contact.W_J_per_m2"), scene.get_real("contact.h0_m"));
     p.contact.quadrature_points = static_cast<int>(scene.get_int("contact.quadrature_points"));
+    p.contact.projected_area = scene.get_string("contact.quadrature_area") == "projected";
     p.contact.friction_on_adhesive_zone = scene.get_string("contact.friction_zone") == "adhesive";
     p.gamma_n = scene.get_real("contact.gamma_n_N_s_per_m3");
     p.gamma_t = scene.get_real("contact.gamma_t_N_s_per_m3");
