@@ -168,8 +168,8 @@ KOKKOS_INLINE_FUNCTION MdState md_state_from_radius(double a, double R, const Md
   const double L = md_length_unit(mat, R);
   const double zone = L * md_solve_zone(st.a / L, md_lambda(mat, R));  // c - a
   st.c = st.a + zone;
-  const double w = math::sqrt(zone * (st.c + st.a));  // sqrt(c^2 - a^2)
-  const double theta = math::atan2(w, st.a);          // acos(a / c)
+  const double w = math::sqrt(zone * (st.c + st.a));         // sqrt(c^2 - a^2)
+  const double theta = math::atan2_first_quadrant(w, st.a);  // acos(a / c)
   st.P = hertz - 2.0 * st.sigma0 * (st.c * st.c * theta + st.a * w);
   return st;
 }
@@ -216,7 +216,7 @@ KOKKOS_INLINE_FUNCTION double md_pressure(const MdState& st, double r) {
   const double in = math::sqrt(math::max(st.a * st.a - r * r, 0.0));
   const double hertz = st.p0 * in / st.a;
   const double w = math::sqrt(math::max(st.c * st.c - st.a * st.a, 0.0));
-  return hertz - 2.0 / kMdPi * st.sigma0 * math::atan2(w, in);
+  return hertz - 2.0 / kMdPi * st.sigma0 * math::atan2_first_quadrant(w, in);
 }
 
 }  // namespace dcm

@@ -131,7 +131,9 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
   const Real3 n = (1.0 / len) * plane.normal, p_plane = plane.point;
   const auto tri_cell = mesh.tri_cell;
   Kokkos::parallel_for(
-      "dcm::contact::plane", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_tris),
+      "dcm::contact::plane",
+      Kokkos::RangePolicy<ExecutionSpace, Kokkos::Schedule<Kokkos::Dynamic>>(space, 0, mesh.n_tris,
+                                                                             Kokkos::ChunkSize(32)),
       KOKKOS_LAMBDA(const int t) {
         for (int k = 0; k < 3; ++k) {
           node_load(t, k) = 0;

@@ -39,6 +39,7 @@ struct MdRadial {
   double a = 0, c = 0, p0 = 0, sigma0 = 0;
   double w = 0, k = 0, q = 0, Fa = 0;  // w = sqrt(c² − a²), k = w/a, q = sqrt(1 + k²), F(a)
   double Ga = 0, Ha = 0;               // G(a), H(a)
+  double inv_a = 0;                    // 1/a
   bool dugdale_inside = false;         // σ0 > 0 and c > a: the Dugdale stress reaches inside a
 };
 
@@ -48,18 +49,19 @@ KOKKOS_INLINE_FUNCTION void md_radial_inside(const MdRadial& m, double rho, doub
   const double a = m.a;
   const double r = math::min(rho, a);
   const double u = math::sqrt(math::max(a * a - r * r, 0.0));
-  const double phi = math::atan2(r, u);  // asin(r/a)
-  g = m.p0 / (3.0 * a) * (a * a * a - u * u * u);
-  h = m.p0 / a * (r * (2 * r * r - a * a) * u + a * a * a * a * phi) / 8.0;
+  const double phi = math::atan2_first_quadrant(r, u);  // asin(r/a)
+  const double p0_a = m.p0 * m.inv_a;
+  g = p0_a / 3.0 * (a * a * a - u * u * u);
+  h = p0_a * (r * (2 * r * r - a * a) * u + a * a * a * a * phi) / 8.0;
   if (m.dugdale_inside) {
     const double w = m.w;
-    const double t = math::atan2(w, u);  // = atan2(k, cos φ)
+    const double t = math::atan2_first_quadrant(w, u);  // = atan2(k, cos φ)
     const double Fu = 0.5 * (u * u + w * w) * t + 0.5 * w * u - 0.25 * kMdPi * w * w;
     g -= 2.0 / kMdPi * m.sigma0 * (m.Fa - Fu);
     if (phi > 0) {
-      const double k = m.k, q = m.q, sn = r / a, cs = u / a;
-      const double kj =
-          k * (phi / 2 + sn * cs / 2 - (2 + k * k) * phi) + q * q * q * math::atan2(k * sn, q * cs);
+      const double k = m.k, q = m.q, sn = r * m.inv_a, cs = u * m.inv_a;
+      const double kj = k * (phi / 2 + sn * cs / 2 - (2 + k * k) * phi) +
+                        q * q * q * math::atan2_first_quadrant(k * sn, q * cs);
       const double d = a * a * a * (sn * sn * sn / 3 * t - kj / 3);
       h -= 2.0 / kMdPi * m.sigma0 * d;
     }
@@ -76,10 +78,11 @@ KOKKOS_INLINE_FUNCTION MdRadial md_radial(const MdState& st) {
   if (!(st.a > 0)) return m;
   m.w = math::sqrt(math::max(st.c * st.c - st.a * st.a, 0.0));
   m.dugdale_inside = st.sigma0 > 0 && m.w > 0;
-  m.k = m.w / st.a;
+  m.inv_a = 1.0 / st.a;
+  m.k = m.w * m.inv_a;
   m.q = math::sqrt(1 + m.k * m.k);
-  m.Fa =
-      0.5 * (st.a * st.a + m.w * m.w) * math::atan2(m.w, st.a) + 0.5 * m.w * st.a - 0.25 * kMdPi * m.w * m.w;
+  m.Fa = 0.5 * (st.a * st.a + m.w * m.w) * math::atan2_first_quadrant(m.w, st.a) + 0.5 * m.w * st.a -
+         0.25 * kMdPi * m.w * m.w;
   detail::md_radial_inside(m, st.a, m.Ga, m.Ha);
   return m;
 }
@@ -167,11 +170,11 @@ KOKKOS_INLINE_FUNCTION void polar_sector(const MdRadial& st, double px, double p
       gauss_legendre8(i, x, wt);
       const double sv = s0 + half * (x + 1);
       const double rx = fx + sv * ux, ry = fy + sv * uy;
-      const double rho2 = h2 + sv * sv, rho = math::sqrt(rho2);
-      const double dtheta = wt * half * kappa / rho2;
+      const double rho2 = h2 + sv * sv, rho = math::sqrt(rho2), inv_rho = 1.0 / rho;
+      const double dtheta = wt * half * kappa * inv_rho * inv_rho;
       double g, hr;
       md_radial_integrals(st, rho, g, hr);
-      const double hm = hr / rho;
+      const double hm = hr * inv_rho;
       out.load += dtheta * g;
       out.m1 += dtheta * hm * ry;  // ê × n = sin θ e1 − cos θ e2
       out.m2 -= dtheta * hm * rx;
@@ -179,7 +182,8 @@ KOKKOS_INLINE_FUNCTION void polar_sector(const MdRadial& st, double px, double p
       out.contact_area += dtheta * 0.5 * ra * ra;
       const double rz = math::min(rho, math::max(st.a, st.c));
       out.zone_area += dtheta * 0.5 * rz * rz;
-      const double ma = dtheta * ra * ra * ra / (3.0 * rho), mz = dtheta * rz * rz * rz / (3.0 * rho);
+      const double third = dtheta * inv_rho / 3.0;
+      const double ma = third * ra * ra * ra, mz = third * rz * rz * rz;
       out.contact_x += ma * rx;  // ∫ r ê(θ) r dr dθ, ê = (rx, ry)/ρ
       out.contact_y += ma * ry;
       out.zone_x += mz * rx;

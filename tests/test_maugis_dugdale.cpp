@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "kernels/maugis_dugdale.hpp"
@@ -104,6 +105,31 @@ std::vector<double> log_grid(double lo, double hi, int n) {
   std::vector<double> v;
   for (int i = 0; i < n; ++i) v.push_back(lo * std::pow(hi / lo, double(i) / (n - 1)));
   return v;
+}
+
+// math::atan2_first_quadrant (core/kokkos_compat.hpp), used by the contact integrals, against std::atan2:
+// y/x over 32 decades, both orderings, the reduction's seams (t = 0.66, t = 1), and the edges x = 0, y = 0.
+TEST(FastAtan2, MatchesTheLibraryToTwoUlpsInTheFirstQuadrant) {
+  double worst = 0;
+  std::vector<double> ratios;
+  for (int e = -160; e <= 160; ++e) ratios.push_back(std::pow(10.0, e / 10.0));
+  for (double t : {0.66, std::nextafter(0.66, 1.0), std::nextafter(0.66, 0.0), 1.0, std::nextafter(1.0, 0.0)})
+    ratios.push_back(t);
+  for (int i = 0; i < 20000; ++i) ratios.push_back((i + 0.5) / 20000.0);
+  for (double t : ratios)
+    for (double scale : {1e-9, 1.0, 3e7}) {
+      const double y = t * scale, x = scale;
+      for (const auto& [a, b] : {std::pair<double, double>{y, x}, std::pair<double, double>{x, y}}) {
+        const double ref = std::atan2(a, b);
+        worst = std::max(worst, std::fabs(math::atan2_first_quadrant(a, b) - ref) / ref);
+      }
+    }
+  std::printf("largest relative error %.2e\n", worst);
+  EXPECT_LT(worst, 4.5e-16);
+  EXPECT_EQ(math::atan2_first_quadrant(0.0, 0.0), 0.0);
+  EXPECT_EQ(math::atan2_first_quadrant(0.0, 2.0), 0.0);
+  EXPECT_NEAR(math::atan2_first_quadrant(2.0, 0.0), std::atan2(2.0, 0.0), 2e-16);
+  EXPECT_TRUE(std::isnan(math::atan2_first_quadrant(std::nan(""), 1.0)));
 }
 
 TEST(MaugisDugdaleSolve, ResidualBelow1e10OnTheGrid) {

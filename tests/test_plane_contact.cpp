@@ -175,7 +175,9 @@ TEST(PlaneContact, PointRulesWeightTheProjectedOrTheTriangleArea) {
     const double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
     const double ratio = std::sqrt(nx * nx + ny * ny + nz * nz) / std::fabs(nz);  // A_t / A_proj
     EXPECT_NEAR(own.load[t] / projected.load[t], ratio, 1e-9 * ratio) << "triangle " << t;
-    if (projected.area[t] > 0) EXPECT_NEAR(own.area[t] / projected.area[t], ratio, 1e-9 * ratio);
+    if (projected.area[t] > 0) {
+      EXPECT_NEAR(own.area[t] / projected.area[t], ratio, 1e-9 * ratio);
+    }
     largest_ratio = std::fmax(largest_ratio, ratio);
     ++loaded;
   }
