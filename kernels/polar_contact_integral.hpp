@@ -14,15 +14,6 @@
 
 namespace dcm {
 
-// 8-point Gauss–Legendre on [−1, 1].
-KOKKOS_INLINE_FUNCTION void gauss_legendre8(int i, double& x, double& w) {
-  constexpr double xs[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267, 0.9602898564975363};
-  constexpr double ws[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
-  const int k = i < 4 ? 3 - i : i - 4;
-  x = i < 4 ? -xs[k] : xs[k];
-  w = ws[k];
-}
-
 // The radial integrals of the MD pressure about the contact centre,
 //   G(ρ) = ∫_0^ρ p(r) r dr (Pa·m²; the load inside radius ρ is 2π G(ρ)),   H(ρ) = ∫_0^ρ p(r) r² dr (Pa·m³),
 // in closed form. Inside the contact radius (ρ < a) with r = a sin φ, u = sqrt(a² − r²) = a cos φ, k = w/a,
@@ -32,9 +23,11 @@ KOKKOS_INLINE_FUNCTION void gauss_legendre8(int i, double& x, double& w) {
 //   ½wv − (π/4)w²,
 //     H −= (2σ0/π) a³ [sin³φ/3 · atan2(k, cos φ) − k J(φ)/3],
 //     J(φ) = φ/2 + sin 2φ/4 − (2 + k²) φ + (1 + k²)^{3/2}/k · atan(k tan φ / sqrt(1 + k²));
-// outside it, −σ0 on a < r < c. MdRadial keeps what depends on the triangle only (w, F(a), G(a), H(a)), so a
-// point with ρ ≥ a costs no transcendental function and one inside a costs three atan2 (φ = atan2(r, u), sin
-// φ = r/a and cos φ = u/a exactly, atan2(k, cos φ) = atan2(w, u)).
+// outside it, −σ0 on a < r < c. MdRadial keeps what depends on the triangle only (w, 1/a, F(a), G(a), H(a)).
+// A point costs a square root and three first-quadrant atan2 (φ = atan2(r, u), sin φ = r/a and cos φ = u/a
+// exactly, atan2(k, cos φ) = atan2(w, u); math::atan2_first_quadrant, no library call); both forms are
+// evaluated and one selected, so that the 8 points of a piece run in SIMD lanes (session 11: the contact
+// kernel 2.0 → 1.1 ms per step on one thread, docs/PERFORMANCE.md).
 struct MdRadial {
   double a = 0, c = 0, p0 = 0, sigma0 = 0;
   double w = 0, k = 0, q = 0, Fa = 0;  // w = sqrt(c² − a²), k = w/a, q = sqrt(1 + k²), F(a)
@@ -44,7 +37,8 @@ struct MdRadial {
 };
 
 namespace detail {
-// G(ρ), H(ρ) for ρ < a (a > 0).
+// G(ρ), H(ρ) by the inside form (ρ ≤ a): Hertz and the Dugdale stress reaching inside a. Finite for every
+// ρ ≥ 0 (r = min(ρ, a), u = 0 beyond a) and for a = 0 (1/a is stored as 0).
 KOKKOS_INLINE_FUNCTION void md_radial_inside(const MdRadial& m, double rho, double& g, double& h) {
   const double a = m.a;
   const double r = math::min(rho, a);
@@ -53,19 +47,15 @@ KOKKOS_INLINE_FUNCTION void md_radial_inside(const MdRadial& m, double rho, doub
   const double p0_a = m.p0 * m.inv_a;
   g = p0_a / 3.0 * (a * a * a - u * u * u);
   h = p0_a * (r * (2 * r * r - a * a) * u + a * a * a * a * phi) / 8.0;
-  if (m.dugdale_inside) {
-    const double w = m.w;
-    const double t = math::atan2_first_quadrant(w, u);  // = atan2(k, cos φ)
-    const double Fu = 0.5 * (u * u + w * w) * t + 0.5 * w * u - 0.25 * kMdPi * w * w;
-    g -= 2.0 / kMdPi * m.sigma0 * (m.Fa - Fu);
-    if (phi > 0) {
-      const double k = m.k, q = m.q, sn = r * m.inv_a, cs = u * m.inv_a;
-      const double kj = k * (phi / 2 + sn * cs / 2 - (2 + k * k) * phi) +
-                        q * q * q * math::atan2_first_quadrant(k * sn, q * cs);
-      const double d = a * a * a * (sn * sn * sn / 3 * t - kj / 3);
-      h -= 2.0 / kMdPi * m.sigma0 * d;
-    }
-  }
+  const double w = m.w;
+  const double t = math::atan2_first_quadrant(w, u);  // = atan2(k, cos φ)
+  const double Fu = 0.5 * (u * u + w * w) * t + 0.5 * w * u - 0.25 * kMdPi * w * w;
+  const double k = m.k, q = m.q, sn = r * m.inv_a, cs = u * m.inv_a;
+  const double kj = k * (phi / 2 + sn * cs / 2 - (2 + k * k) * phi) +
+                    q * q * q * math::atan2_first_quadrant(k * sn, q * cs);
+  const double d = a * a * a * (sn * sn * sn / 3 * t - kj / 3);
+  g = m.dugdale_inside ? g - 2.0 / kMdPi * m.sigma0 * (m.Fa - Fu) : g;
+  h = m.dugdale_inside && phi > 0 ? h - 2.0 / kMdPi * m.sigma0 * d : h;
 }
 }  // namespace detail
 
@@ -87,19 +77,18 @@ KOKKOS_INLINE_FUNCTION MdRadial md_radial(const MdState& st) {
   return m;
 }
 
-// G(ρ) and H(ρ) (see MdRadial).
+// G(ρ) and H(ρ) (see MdRadial). Without branches (the quadrature points of a sector are computed in SIMD
+// lanes): the inside and the outside forms are both evaluated and one is selected.
 KOKKOS_INLINE_FUNCTION void md_radial_integrals(const MdRadial& m, double rho, double& g, double& h) {
-  if (m.a > 0 && rho < m.a) {
-    detail::md_radial_inside(m, rho, g, h);
-    return;
-  }
-  g = m.Ga;
-  h = m.Ha;
-  if (rho > m.a && m.c > m.a) {  // −σ0 on a < r < c
-    const double r = math::min(rho, m.c);
-    g -= 0.5 * m.sigma0 * (r * r - m.a * m.a);
-    h -= m.sigma0 * (r * r * r - m.a * m.a * m.a) / 3.0;
-  }
+  double gi, hi;
+  detail::md_radial_inside(m, rho, gi, hi);
+  const double a = m.a, ro = math::min(rho, m.c);
+  const bool ring = rho > a && m.c > a;  // −σ0 on a < r < c
+  const double go = ring ? m.Ga - 0.5 * m.sigma0 * (ro * ro - a * a) : m.Ga;
+  const double ho = ring ? m.Ha - m.sigma0 * (ro * ro * ro - a * a * a) / 3.0 : m.Ha;
+  const bool inside = a > 0 && rho < a;
+  g = inside ? gi : go;
+  h = inside ? hi : ho;
 }
 
 // G(ρ) = ∫_0^ρ p(r) r dr (Pa·m²): the load inside radius ρ is 2π G(ρ).
@@ -165,29 +154,46 @@ KOKKOS_INLINE_FUNCTION void polar_sector(const MdRadial& st, double px, double p
   for (int piece = 0; piece + 1 < n_cuts; ++piece) {
     const double s0 = cuts[piece], half = 0.5 * (cuts[piece + 1] - s0);
     if (half == 0) continue;
+    // 8-point Gauss–Legendre on [−1, 1] (local arrays: also valid in device code). The 8 points in lanes (no
+    // branches, so the host compiler vectorises them), then summed in order.
+    constexpr double gx[8] = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290,
+                              -0.1834346424956498, 0.1834346424956498,  0.5255324099163290,
+                              0.7966664774136267,  0.9602898564975363};
+    constexpr double gw[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066458778873, 0.3626837833783620,
+                              0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
+    double load[8], m1[8], m2[8], ca[8], za[8], cx[8], cy[8], zx[8], zy[8];
     for (int i = 0; i < 8; ++i) {
-      double x, wt;
-      gauss_legendre8(i, x, wt);
-      const double sv = s0 + half * (x + 1);
+      const double sv = s0 + half * (gx[i] + 1);
       const double rx = fx + sv * ux, ry = fy + sv * uy;
       const double rho2 = h2 + sv * sv, rho = math::sqrt(rho2), inv_rho = 1.0 / rho;
-      const double dtheta = wt * half * kappa * inv_rho * inv_rho;
+      const double dtheta = gw[i] * half * kappa * inv_rho * inv_rho;
       double g, hr;
       md_radial_integrals(st, rho, g, hr);
       const double hm = hr * inv_rho;
-      out.load += dtheta * g;
-      out.m1 += dtheta * hm * ry;  // ê × n = sin θ e1 − cos θ e2
-      out.m2 -= dtheta * hm * rx;
+      load[i] = dtheta * g;
+      m1[i] = dtheta * hm * ry;  // ê × n = sin θ e1 − cos θ e2
+      m2[i] = dtheta * hm * rx;
       const double ra = math::min(rho, st.a);
-      out.contact_area += dtheta * 0.5 * ra * ra;
+      ca[i] = dtheta * 0.5 * ra * ra;
       const double rz = math::min(rho, math::max(st.a, st.c));
-      out.zone_area += dtheta * 0.5 * rz * rz;
+      za[i] = dtheta * 0.5 * rz * rz;
       const double third = dtheta * inv_rho / 3.0;
       const double ma = third * ra * ra * ra, mz = third * rz * rz * rz;
-      out.contact_x += ma * rx;  // ∫ r ê(θ) r dr dθ, ê = (rx, ry)/ρ
-      out.contact_y += ma * ry;
-      out.zone_x += mz * rx;
-      out.zone_y += mz * ry;
+      cx[i] = ma * rx;  // ∫ r ê(θ) r dr dθ, ê = (rx, ry)/ρ
+      cy[i] = ma * ry;
+      zx[i] = mz * rx;
+      zy[i] = mz * ry;
+    }
+    for (int i = 0; i < 8; ++i) {
+      out.load += load[i];
+      out.m1 += m1[i];
+      out.m2 -= m2[i];
+      out.contact_area += ca[i];
+      out.zone_area += za[i];
+      out.contact_x += cx[i];
+      out.contact_y += cy[i];
+      out.zone_x += zx[i];
+      out.zone_y += zy[i];
     }
   }
 }
