@@ -6,7 +6,7 @@ usage: step_table.py BENCH.csv [--ns]   (--ns: ns per node per step instead of Â
 Kernels are grouped by what they do in a step:
   geometry      triangle areas/normals, curvature, rounded-triangle spheres, cell area and volume
   bonds, bending, area, volume, external   the force terms (bending: hinge pass + gather)
-  membrane (fused)  the four membrane terms in one triangle pass, one edge pass and a gather
+  membrane (fused)  the four membrane terms in one edge pass (with the triangles on their wings) and a gather
                 (kernels/membrane_forces.hpp; the default when all four are on)
   contact       plane contact per triangle, gather, sums
   solver set-up per step: bond directions, block-Jacobi blocks, implicit bending/tension/global stiffness,
