@@ -24,6 +24,9 @@
 //
 // Expectations (tests/test_membrane_forces.cpp): the same forces, hinge scratch and overstretch flag as the
 // per-term kernels (to rounding), on meshes with several cells and per-cell constants.
+#include <stdexcept>
+#include <string>
+
 #include "core/cell_params.hpp"
 #include "core/geometry.hpp"
 #include "core/vec3.hpp"
@@ -94,6 +97,11 @@ struct MembraneScratch {
         edge_tri("dcm::membrane::edge_tri", mesh.n_hinges),
         cell_factor("dcm::membrane::cell_factor", mesh.n_cells) {
     fill_membrane_slots(mesh, edge_slot, edge_tri);
+    const auto tris = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), edge_tri);
+    for (int e = 0; e < mesh.n_hinges; ++e)
+      if (tris(e, 0) < 0 || tris(e, 1) < 0)
+        throw std::invalid_argument("membrane pass: edge " + std::to_string(e) +
+                                    " lacks a triangle (i, j, k) or (j, i, l) with its hinge's wing");
   }
 };
 
