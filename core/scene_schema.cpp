@@ -191,6 +191,10 @@ std::vector<ParamSpec> make_schema() {
       bool_key("solver.implicit_tension", "true",
                "the area terms' tension stiffness (out of the surface) in the velocity solve: a flat, tense "
                "patch of cortex does not spike at the paper's Δt (solvers/tension_stiffness.hpp)"),
+      bool_key("solver.precondition_volume", "true",
+               "the implicit volume stiffness (rank one per cell) also in the preconditioner, by the "
+               "Sherman–Morrison identity (solvers/global_woodbury.hpp): fewer CG iterations with long "
+               "steps"),
 
       string_key("output.dir", "", {}, "output directory (empty: out/<name>)"),
       bool_key("output.hdf5", "true", "write the HDF5 + XDMF output"),

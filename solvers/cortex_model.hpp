@@ -31,6 +31,7 @@
 #include "solvers/bending_stiffness.hpp"
 #include "solvers/friction_operator.hpp"
 #include "solvers/global_stiffness.hpp"
+#include "solvers/global_woodbury.hpp"
 #include "solvers/multigrid.hpp"
 #include "solvers/pcg.hpp"
 #include "solvers/tension_stiffness.hpp"
@@ -55,8 +56,10 @@ struct MechanicsParams {
   bool implicit_bending =
       false;  // bending's Gauss-Newton stiffness in the solve (solvers/bending_stiffness.hpp)
   bool implicit_tension = false;  // the area terms' tension stiffness in the solve (tension_stiffness.hpp)
-  double gravity = 0;             // m/s², along −z (paper eq. 32's F_gravity); 0: no gravity term
-  double density_excess = 0;      // kg/m³, cell minus medium (buoyant weight Δρ V* g per cell)
+  // The implicit volume stiffness also in the preconditioner (solvers/global_woodbury.hpp).
+  bool precondition_volume = false;
+  double gravity = 0;         // m/s², along −z (paper eq. 32's F_gravity); 0: no gravity term
+  double density_excess = 0;  // kg/m³, cell minus medium (buoyant weight Δρ V* g per cell)
   // A substrate plane with Maugis–Dugdale adhesion (kernels/plane_contact.hpp) and substrate friction
   // γ_n, γ_t (N·s/m³); no plane: no contact kernel runs.
   bool has_plane = false;
@@ -91,7 +94,8 @@ inline std::string batch_mismatch(const MechanicsParams& a, const MechanicsParam
       {"the curvature clamp h_min", a.h_min != b.h_min},
       {"the preconditioner (multigrid, its sweeps and damping)",
        a.multigrid != b.multigrid || a.mg.sweeps != b.mg.sweeps || a.mg.damping != b.mg.damping ||
-           a.mg.bending_min_nodes != b.mg.bending_min_nodes},
+           a.mg.bending_min_nodes != b.mg.bending_min_nodes ||
+           a.precondition_volume != b.precondition_volume},
       {"the implicit terms", a.implicit_bonds != b.implicit_bonds ||
                                  a.implicit_bending != b.implicit_bending ||
                                  a.implicit_tension != b.implicit_tension},
@@ -168,6 +172,7 @@ class CortexModel {
       membrane_ = MembraneScratch<Mem>(mesh_);
     if (p.k_area_global > 0 || p.k_volume > 0)
       global_ = GlobalStiffness<Mem>(mesh_, p.k_area_global > 0, p.k_volume > 0);
+    if (global_ && global_->volume && p.precondition_volume) woodbury_ = GlobalWoodbury<Mem>(mesh_);
     if (p.gravity != 0 && p.density_excess != 0) gravity_ = node_weights(cells);
     friction_ = FrictionOperator<Mem>(mesh_, node_drag(cells), p.dashpot, p.dashpot_transverse);
     if (p.has_plane) {
@@ -436,6 +441,18 @@ class CortexModel {
       update_global_stiffness(space_, mesh_, geo_, area_ ? area_->cell_area : volume_->cell_volume,
                               volume_ ? volume_->cell_volume : area_->cell_area, k_area_global_.table(),
                               k_volume_.table(), dt_.table(), *global_);
+    const auto precondition_without_global = [&](const Vector& in, const Vector& out,
+                                                 const CellFlags<Mem>& rows) {
+      if (multigrid_)
+        apply_multigrid(space_, *multigrid_, in, out, rows);
+      else
+        apply_block_jacobi(space_, friction_, in, out);
+    };
+    const bool woodbury = implicit && woodbury_.has_value();
+    if (woodbury)
+      update_global_woodbury(space_, mesh_, *global_, *woodbury_, [&](const Vector& in, const Vector& out) {
+        precondition_without_global(in, out, CellFlags<Mem>());
+      });
     if (params_.dashpot == 0 && params_.dashpot_transverse == 0 && !friction_.substrate && !implicit &&
         !implicit_bending && !implicit_bonds && !implicit_tension) {
       apply_block_jacobi(space_, friction_, force_, velocity_);  // exact: Γ is block-diagonal (a frozen
@@ -462,10 +479,8 @@ class CortexModel {
             apply_bending_stiffness(space_, mesh_, *hinges_, *bending_stiffness_, in, out, active);
         },
         [&](const Vector& in, const Vector& out) {
-          if (multigrid_)
-            apply_multigrid(space_, *multigrid_, in, out, active);
-          else
-            apply_block_jacobi(space_, friction_, in, out);
+          precondition_without_global(in, out, active);
+          if (woodbury) apply_global_woodbury(space_, mesh_, *woodbury_, in, out, active);
         },
         force_, velocity_, cg_, settings, frozen);
     if (!r.converged && !(r.residual_norm < INFINITY)) {
@@ -662,6 +677,7 @@ class CortexModel {
   std::optional<VolumeRest<Mem>> volume_;
   std::optional<MembraneScratch<Mem>> membrane_;  // set: the fused membrane pass
   std::optional<GlobalStiffness<Mem>> global_;
+  std::optional<GlobalWoodbury<Mem>> woodbury_;  // set: the volume term in the preconditioner
   std::optional<Multigrid<Mem>> multigrid_;
   std::optional<BendingStiffness<Mem>> bending_stiffness_;
   std::optional<TensionStiffness<Mem>> tension_stiffness_;

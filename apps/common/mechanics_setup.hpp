@@ -37,6 +37,7 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
   p.implicit_bending = scene.get_bool("solver.implicit_bending");
   p.implicit_bonds = scene.get_bool("solver.implicit_bonds");
   p.implicit_tension = scene.get_bool("solver.implicit_tension");
+  p.precondition_volume = scene.get_bool("solver.precondition_volume");
   p.gravity = scene.get_real("body.gravity_m_per_s2");
   p.density_excess = scene.get_real("body.density_excess_kg_per_m3");
   p.has_plane = scene.get_bool("contact.plane");
