@@ -441,7 +441,7 @@ class CortexModel {
       update_global_stiffness(space_, mesh_, geo_, area_ ? area_->cell_area : volume_->cell_volume,
                               volume_ ? volume_->cell_volume : area_->cell_area, k_area_global_.table(),
                               k_volume_.table(), dt_.table(), *global_);
-    const auto precondition_without_global = [&](const Vector& in, const Vector& out,
+    const auto precondition_without_volume = [&](const Vector& in, const Vector& out,
                                                  const CellFlags<Mem>& rows) {
       if (multigrid_)
         apply_multigrid(space_, *multigrid_, in, out, rows);
@@ -451,7 +451,7 @@ class CortexModel {
     const bool woodbury = implicit && woodbury_.has_value();
     if (woodbury)
       update_global_woodbury(space_, mesh_, *global_, *woodbury_, [&](const Vector& in, const Vector& out) {
-        precondition_without_global(in, out, CellFlags<Mem>());
+        precondition_without_volume(in, out, CellFlags<Mem>());
       });
     if (params_.dashpot == 0 && params_.dashpot_transverse == 0 && !friction_.substrate && !implicit &&
         !implicit_bending && !implicit_bonds && !implicit_tension) {
@@ -479,7 +479,7 @@ class CortexModel {
             apply_bending_stiffness(space_, mesh_, *hinges_, *bending_stiffness_, in, out, active);
         },
         [&](const Vector& in, const Vector& out) {
-          precondition_without_global(in, out, active);
+          precondition_without_volume(in, out, active);
           if (woodbury) apply_global_woodbury(space_, mesh_, *woodbury_, in, out, active);
         },
         force_, velocity_, cg_, settings, frozen);
