@@ -191,7 +191,7 @@ std::vector<ParamSpec> make_schema() {
       bool_key("solver.implicit_tension", "true",
                "the area terms' tension stiffness (out of the surface) in the velocity solve: a flat, tense "
                "patch of cortex does not spike at the paper's Δt (solvers/tension_stiffness.hpp)"),
-      bool_key("solver.precondition_volume", "true",
+      bool_key("solver.precondition_volume", "false",
                "the implicit volume stiffness (rank one per cell) also in the preconditioner, by the "
                "Sherman–Morrison identity (solvers/global_woodbury.hpp): fewer CG iterations with long "
                "steps"),

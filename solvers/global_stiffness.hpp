@@ -6,9 +6,10 @@
 // the friction operator makes the step
 //     (Γ + Δt K_global) v = F(x_n),   x_{n+1} = x_n + Δt v
 // implicit in exactly these modes; Γ + Δt K_global stays symmetric positive definite, and applying it
-// costs one reduction per cell and constraint. The preconditioner gets the volume term by the
-// Sherman–Morrison identity (solvers/global_woodbury.hpp, solver.precondition_volume); the area term, which
-// saved no iteration that way, is left to the CG (a rank-one change costs it at most an iteration or two).
+// costs one reduction per cell and constraint. The preconditioner can get the volume term by the
+// Sherman–Morrison identity (solvers/global_woodbury.hpp, solver.precondition_volume, off by default); the
+// area term, which saved no iteration that way, is left to the CG (a rank-one change costs it at most an
+// iteration or two).
 #include "core/cell_params.hpp"
 #include "core/geometry.hpp"
 #include "core/vec3.hpp"

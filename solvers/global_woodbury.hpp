@@ -14,6 +14,8 @@
 // The global area term (eq. 28) is rank one too, but the same correction for it saved no iteration on the
 // Hategan scene (4.70 CG per step to t = 0.3 s with and without it) and would cost a second application of P
 // per step; it is left to the CG (docs/model/solver.md, "The volume term in the preconditioner").
+// Off by default (solver.precondition_volume): with the multigrid the extra application of P per step costs
+// about what it saves with long steps, and more than it saves at the paper's Δt (docs/model/solver.md).
 // Expectations (tests/test_solver.cpp): P (r − s u uᵀ z) = z for z = M⁻¹ r, and fewer PCG iterations with a
 // stiff volume term.
 #include "core/buffers.hpp"
