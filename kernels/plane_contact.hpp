@@ -130,6 +130,9 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
   const double len = norm(plane.normal);
   const Real3 n = (1.0 / len) * plane.normal, p_plane = plane.point;
   const auto tri_cell = mesh.tri_cell;
+  // Dynamic chunks: the triangles in contact are one patch of the mesh, which a static split hands to one
+  // thread (2 threads, 2562 nodes pressed 1 µm: 1.8 → 1.3 ms per step; docs/PERFORMANCE.md "Session 11").
+  // Each triangle's results depend on that triangle only, so the schedule changes no bit.
   Kokkos::parallel_for(
       "dcm::contact::plane",
       Kokkos::RangePolicy<ExecutionSpace, Kokkos::Schedule<Kokkos::Dynamic>>(space, 0, mesh.n_tris,
