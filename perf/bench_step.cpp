@@ -10,9 +10,14 @@
 // tension). One row per (space, threads, scene, nodes, kernel): µs per step and ns per node per step; the
 // kernel "step" is the whole step (host work, copies and fences included), "other" what no kernel covers.
 //   bench_step [--levels 3,4,5,6] [--scenes stretch,spread,diagonal] [--steps N] [--warmup N] [--threads 1,2]
-//              [--repeat N] [--set KEY=VALUE]...
+//              [--repeat N] [--rounds R] [--set KEY=VALUE]...
 // --repeat N runs each case N times from the same start (warm-up and timed steps) and reports the run with
 // the shortest step time, kernels included (the best of N: a shared machine's slow spells drop out).
+// --rounds R runs the whole sequence of children R times, one thread count after the other in each round,
+// and reports for every case the round with the shortest step (its kernel rows with it): a slow spell that
+// lasts longer than one case's repeats then spoils one round, not one thread count, so the 1- and 2-thread
+// rows of a table are both from quiet moments (docs/PERFORMANCE.md, "Session 12"). The rows are printed when
+// all rounds are done; with one round they stream as each case finishes.
 // Each OpenMP thread count runs in a child process of this binary (OMP_NUM_THREADS is fixed at Kokkos start);
 // Serial runs once, in the first. CSV on stdout (docs/PERFORMANCE.md turns it into tables).
 #include <unistd.h>
@@ -68,7 +73,7 @@ struct Options {
   std::vector<int> levels{3, 4, 5, 6};
   std::vector<std::string> scenes{"stretch", "spread", "diagonal"};
   std::vector<int> threads{1, 2};
-  int steps = 20, warmup = 5, repeat = 1;
+  int steps = 20, warmup = 5, repeat = 1, rounds = 1;
   bool child = false, serial = true;
   std::vector<std::string> sets;  // scene overrides for every case (applied last)
 };
@@ -189,6 +194,9 @@ int main(int argc, char** argv) {
   app.add_option("--repeat", o.repeat,
                  "runs of each case from the same start (warm-up + timed steps); the fastest is reported")
       ->check(CLI::Range(1, 1000));
+  app.add_option("--rounds", o.rounds,
+                 "runs of the whole sequence of thread counts; each case reports its fastest round")
+      ->check(CLI::Range(1, 1000));
   app.add_option("--set", o.sets,
                  "KEY=VALUE: a scene key for every case, e.g. --set solver.cg_abs_tol_N=4e-14");
   app.add_flag("--child", o.child, "(internal) run one thread count, no header, no Serial unless --serial");
@@ -230,16 +238,47 @@ int main(int argc, char** argv) {
     return 1;
   }
   self[len] = '\0';
-  for (std::size_t k = 0; k < o.threads.size(); ++k) {
-    std::string cmd = "OMP_NUM_THREADS=" + std::to_string(o.threads[k]) + " OMP_PROC_BIND=false '" + self +
-                      "' --child --levels " + join(o.levels) + " --scenes " + scenes + " --steps " +
-                      std::to_string(o.steps) + " --warmup " + std::to_string(o.warmup) + " --repeat " +
-                      std::to_string(o.repeat) + (k == 0 && o.serial ? " --serial" : " --no-serial");
-    for (const std::string& set : o.sets) cmd += " --set '" + set + "'";
-    if (std::system(cmd.c_str()) != 0) {
-      std::cerr << "bench_step: error: the run with " << o.threads[k] << " OpenMP threads failed\n";
-      return 1;
+  // The rows of each case (space, threads, scene, nodes) in the order they first came, and the fastest
+  // round's rows of it (--rounds).
+  std::vector<std::string> order;
+  std::map<std::string, std::pair<double, std::vector<std::string>>> best;
+  for (int round = 0; round < o.rounds; ++round)
+    for (std::size_t k = 0; k < o.threads.size(); ++k) {
+      std::string cmd = "OMP_NUM_THREADS=" + std::to_string(o.threads[k]) + " OMP_PROC_BIND=false '" + self +
+                        "' --child --levels " + join(o.levels) + " --scenes " + scenes + " --steps " +
+                        std::to_string(o.steps) + " --warmup " + std::to_string(o.warmup) + " --repeat " +
+                        std::to_string(o.repeat) + (k == 0 && o.serial ? " --serial" : " --no-serial");
+      for (const std::string& set : o.sets) cmd += " --set '" + set + "'";
+      const auto failed = [&] {
+        std::cerr << "bench_step: error: the run with " << o.threads[k] << " OpenMP threads failed\n";
+        return 1;
+      };
+      if (o.rounds == 1) {
+        if (std::system(cmd.c_str()) != 0) return failed();
+        continue;
+      }
+      FILE* child = popen(cmd.c_str(), "r");
+      if (!child) return failed();
+      std::vector<std::string> rows;  // of the case being read
+      char line[4096];
+      while (std::fgets(line, sizeof line, child)) {
+        const std::string row(line);
+        rows.push_back(row);
+        // space,threads,scene,nodes,kernel,us_per_step,...: a case ends with its "step" row
+        std::vector<std::string> field;
+        std::stringstream fs(row);
+        for (std::string f; std::getline(fs, f, ',');) field.push_back(f);
+        if (field.size() < 6 || field[4] != "step") continue;
+        const std::string key = field[0] + "," + field[1] + "," + field[2] + "," + field[3];
+        const double us = std::atof(field[5].c_str());
+        const auto it = best.find(key);
+        if (it == best.end()) order.push_back(key);
+        if (it == best.end() || us < it->second.first) best[key] = {us, rows};
+        rows.clear();
+      }
+      if (pclose(child) != 0) return failed();
     }
-  }
+  for (const std::string& key : order)
+    for (const std::string& row : best[key].second) std::fputs(row.c_str(), stdout);
   return 0;
 }
