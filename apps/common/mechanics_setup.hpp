@@ -78,10 +78,10 @@ inline TimeStepSettings steps_from_scene(const Scene& scene) {
   s.dt_max = scene.get_real("time.dt_max_s");
   s.contact_change = scene.get_real("time.contact_change");
   if (s.adaptive && !(s.dt_min <= s.dt && s.dt <= s.dt_max))
-    throw SceneError("time.dt_s = " + std::to_string(s.dt) +
+    throw SceneError("time.dt_s = " + detail::format_real(s.dt) +
                      " is not allowed with time.adaptive = true: it must "
                      "lie in [time.dt_min_s, time.dt_max_s] = [" +
-                     std::to_string(s.dt_min) + ", " + std::to_string(s.dt_max) + "]");
+                     detail::format_real(s.dt_min) + ", " + detail::format_real(s.dt_max) + "]");
   return s;
 }
 
