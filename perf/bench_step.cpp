@@ -257,6 +257,8 @@ int main(int argc, char** argv) {
         if (std::system(cmd.c_str()) != 0) return failed();
         continue;
       }
+      std::fprintf(stderr, "bench_step: round %d of %d, %d OpenMP thread(s)\n", round + 1, o.rounds,
+                   o.threads[k]);  // (the rows come when every round is done)
       FILE* child = popen(cmd.c_str(), "r");
       if (!child) return failed();
       std::vector<std::string> rows;  // of the case being read
