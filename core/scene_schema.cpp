@@ -119,6 +119,11 @@ std::vector<ParamSpec> make_schema() {
       bool_key("contact.plane", "false",
                "a substrate plane z = contact.plane_z_m with Maugis–Dugdale adhesion and substrate friction"),
       real_key("contact.plane_z_m", "0", -1e-3, 1e-3, kIncl, "m", "height of the substrate plane"),
+      string_key("contact.law", "maugis_dugdale", {"maugis_dugdale", "derjaguin"},
+                 "the adhesion model: maugis_dugdale = the paper's rounded triangles with the Maugis–Dugdale "
+                 "pressure (eqs. 3–19); derjaguin = flat triangles with the Derjaguin energy −W per bound "
+                 "area and its exact gradient, which adds the in-plane contact-line force (dcm's extension, "
+                 "docs/model/contact_line.md)"),
       int_choice_key("contact.quadrature_points", "0", {"0", "1", "3", "7", "16"},
                      "pressure integration over a triangle: 0 = exact in r (dcm's default), 1/3/7/16 = the "
                      "paper's point rules (eq. 18)"),

@@ -65,7 +65,8 @@ void compute_node_fields(const ExecutionSpace& space, const MeshBuffers<MemorySp
       });
 }
 
-// Σ_t Σ_c f_tc (n̂ · v_node(t,c)): the power of the contact forces (W).
+// Σ_t Σ_c f_tc (n̂ · v_node(t,c)) (+ the in-plane forces' Σ s_tc · v_node(t,c)): the power of the contact
+// forces (W).
 template <class ExecutionSpace, class MemorySpace>
 double contact_power(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh, const Plane& plane,
                      const ContactBuffers<MemorySpace>& contact,
@@ -73,12 +74,18 @@ double contact_power(const ExecutionSpace& space, const MeshBuffers<MemorySpace>
                      std::vector<double>* per_cell = nullptr) {
   const auto tri = mesh.tri;
   const auto load = contact.tri_node_load;
+  const auto shear = contact.tri_node_shear;
+  const bool has_shear = shear.extent(0) > 0;
   const Real3 n = (1.0 / norm(plane.normal)) * plane.normal;
   return fixed_order_sum(
       "dcm::fields::contact_power", space, mesh.tri_sums,
       KOKKOS_LAMBDA(const int t) {
         double s = 0;
-        for (int c = 0; c < 3; ++c) s += load(t, c) * dot(n, load3(velocity, tri(t, c)));
+        for (int c = 0; c < 3; ++c) {
+          const Real3 v = load3(velocity, tri(t, c));
+          s += load(t, c) * dot(n, v);
+          if (has_shear) s += shear(t, c, 0) * v.x + shear(t, c, 1) * v.y + shear(t, c, 2) * v.z;
+        }
         return s;
       },
       per_cell);

@@ -15,6 +15,7 @@
 #include "core/geometry.hpp"
 #include "core/vec3.hpp"
 #include "kernels/contact_distribution.hpp"
+#include "kernels/derjaguin_adhesion.hpp"
 #include "kernels/maugis_dugdale.hpp"
 #include "kernels/polar_contact_integral.hpp"
 #include "kernels/quadrature_rules.hpp"
@@ -34,6 +35,9 @@ struct PlaneContactParams {
   // Substrate friction acts on the triangle's area within r < max(a, c) (contact and adhesive zone; dcm's
   // default, docs/model/contact.md) or, as the paper writes, within the contact radius a only.
   bool friction_on_adhesive_zone = true;
+  // contact.law = "derjaguin": flat triangles with the Derjaguin energy of kernels/derjaguin_adhesion.hpp
+  // (forces in and out of the plane) instead of the rounded triangles' Maugis–Dugdale pressure.
+  bool derjaguin = false;
 };
 
 // What a triangle's contact is doing (tri_regime).
@@ -54,8 +58,14 @@ struct ContactBuffers {
   View<double*> tri_friction_area;  // the area the substrate friction acts on (m²): A^C_t or the zone r < c
   View<double*> tri_load;           // F_t · n (N), repulsive positive
   View<int*> tri_regime;            // ContactRegime
+  // In-plane force on each corner's node (N), from contact.law = "derjaguin" only; empty otherwise (the
+  // rounded triangles' forces are along the plane normal).
+  View<double* [3][3]> tri_node_shear;
 
   ContactBuffers() = default;
+  ContactBuffers(int n_tris, bool in_plane_forces) : ContactBuffers(n_tris) {
+    if (in_plane_forces) tri_node_shear = View<double* [3][3]>("dcm::contact::tri_node_shear", n_tris);
+  }
   explicit ContactBuffers(int n_tris)
       : tri_node_load("dcm::contact::tri_node_load", n_tris),
         tri_beta("dcm::contact::tri_beta", n_tris),
@@ -127,6 +137,8 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
   const auto friction_area = out.tri_friction_area;
   const auto load = out.tri_load;
   const auto regime = out.tri_regime;
+  const auto shear = out.tri_node_shear;
+  const bool has_shear = shear.extent(0) > 0;
   const double len = norm(plane.normal);
   const Real3 n = (1.0 / len) * plane.normal, p_plane = plane.point;
   const auto tri_cell = mesh.tri_cell;
@@ -147,8 +159,37 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
         friction_area(t) = 0;
         load(t) = 0;
         regime(t) = kNoContact;
+        if (has_shear)
+          for (int k = 0; k < 3; ++k)
+            for (int d = 0; d < 3; ++d) shear(t, k, d) = 0;
         const PlaneContactParams prm = cell_value(params, tri_cell(t));
         const Real3 x0 = load3(x, tri(t, 0)), x1 = load3(x, tri(t, 1)), x2 = load3(x, tri(t, 2));
+        if (prm.derjaguin) {  // flat triangles, the Derjaguin energy's exact gradient
+          const DerjaguinLaw law{prm.material.W, prm.material.h0, prm.material.K};
+          const DerjaguinTriangle dt = derjaguin_triangle(law, x0, x1, x2, p_plane, n);
+          const double fa = prm.friction_on_adhesive_zone ? dt.zone_area : dt.contact_area;
+          const double* w = prm.friction_on_adhesive_zone ? dt.zone_weight : dt.contact_weight;
+          double total = 0;
+          for (int k = 0; k < 3; ++k) {
+            node_load(t, k) = dt.normal_force[k];
+            total += dt.normal_force[k];
+            beta(t, k) = fa > 0 ? w[k] : 1.0 / 3.0;
+            area_weight(t, k) = beta(t, k);
+            if (has_shear) {
+              shear(t, k, 0) = dt.shear[k].x;
+              shear(t, k, 1) = dt.shear[k].y;
+              shear(t, k, 2) = dt.shear[k].z;
+            }
+          }
+          load(t) = total;
+          contact_area(t) = dt.contact_area;
+          friction_area(t) = fa;
+          if (dt.contact_area > 0)
+            regime(t) = dt.highest < derjaguin_contact_gap(law) ? kFullContact : kQuadrature;
+          else if (dt.zone_area > 0)
+            regime(t) = kGap;
+          return;
+        }
         const double R = radius(t);
         const Real3 O = load3(center, t);
         const double height = dot(O - p_plane, n);  // of the sphere centre
@@ -247,7 +288,8 @@ KOKKOS_INLINE_FUNCTION bool node_fully_in_contact(int i, const Offsets& offsets,
   return true;
 }
 
-// Adds the contact forces (along the plane normal) gathered from the triangles' corners to force.
+// Adds the contact forces (along the plane normal, and in the plane with contact.law = "derjaguin") gathered
+// from the triangles' corners to force.
 template <class ExecutionSpace, class MemorySpace>
 void add_plane_contact_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                               const Plane& plane, const ContactBuffers<MemorySpace>& contact,
@@ -255,18 +297,49 @@ void add_plane_contact_forces(const ExecutionSpace& space, const MeshBuffers<Mem
   const auto offsets = mesh.node_tri_offsets;
   const auto corners = mesh.node_tri_corners;
   const auto node_load = contact.tri_node_load;
+  const auto shear = contact.tri_node_shear;
+  const bool has_shear = shear.extent(0) > 0;
   const Real3 n = (1.0 / norm(plane.normal)) * plane.normal;
   Kokkos::parallel_for(
       "dcm::contact::gather", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
       KOKKOS_LAMBDA(const int i) {
         double f = 0;
+        Real3 s{0, 0, 0};
         for (int k = offsets(i); k < offsets(i + 1); ++k) {
           const int corner = corners(k);
           f += node_load(corner / 3, corner % 3);
+          if (has_shear)
+            s = s + Real3{shear(corner / 3, corner % 3, 0), shear(corner / 3, corner % 3, 1),
+                          shear(corner / 3, corner % 3, 2)};
         }
-        if (f != 0)
-          for (int d = 0; d < 3; ++d) force(i, d) += f * (d == 0 ? n.x : d == 1 ? n.y : n.z);
+        if (f != 0 || norm2(s) != 0) {
+          const Real3 total = f * n + s;
+          force(i, 0) += total.x;
+          force(i, 1) += total.y;
+          force(i, 2) += total.z;
+        }
       });
+}
+
+// Σ_t E_t, the Derjaguin adhesion energy of the triangles whose cell uses contact.law = "derjaguin" (J; the
+// Maugis–Dugdale pressure of the rounded triangles has no energy and adds 0). per_cell: each cell's.
+template <class ExecutionSpace, class MemorySpace, class Params>
+double derjaguin_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh, const Plane& plane,
+                        const Params& params, std::vector<double>* per_cell = nullptr) {
+  const auto x = mesh.x;
+  const auto tri = mesh.tri;
+  const auto tri_cell = mesh.tri_cell;
+  const Real3 n = (1.0 / norm(plane.normal)) * plane.normal, p = plane.point;
+  return fixed_order_sum(
+      "dcm::contact::derjaguin_energy", space, mesh.tri_sums,
+      KOKKOS_LAMBDA(const int t) {
+        const PlaneContactParams prm = cell_value(params, tri_cell(t));
+        if (!prm.derjaguin) return 0.0;
+        const DerjaguinLaw law{prm.material.W, prm.material.h0, prm.material.K};
+        return derjaguin_triangle(law, load3(x, tri(t, 0)), load3(x, tri(t, 1)), load3(x, tri(t, 2)), p, n)
+            .energy;
+      },
+      per_cell);
 }
 
 // Σ_t A^C_t over the mesh (r_cc = sqrt(A^C / π) of a one-cell mesh); per_cell: each cell's. Fixed summation

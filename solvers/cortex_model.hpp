@@ -105,8 +105,9 @@ inline std::string batch_mismatch(const MechanicsParams& a, const MechanicsParam
            (a.has_plane && (a.plane.point.x != b.plane.point.x || a.plane.point.y != b.plane.point.y ||
                             a.plane.point.z != b.plane.point.z || a.plane.normal.x != b.plane.normal.x ||
                             a.plane.normal.y != b.plane.normal.y || a.plane.normal.z != b.plane.normal.z))},
-      {"the contact integration (quadrature points, projected area, friction zone)",
-       a.contact.quadrature_points != b.contact.quadrature_points ||
+      {"the contact law or its integration (quadrature points, projected area, friction zone)",
+       a.contact.derjaguin != b.contact.derjaguin ||
+           a.contact.quadrature_points != b.contact.quadrature_points ||
            a.contact.projected_area != b.contact.projected_area ||
            a.contact.friction_on_adhesive_zone != b.contact.friction_on_adhesive_zone},
       {"substrate friction on/off", on(a.gamma_n) != on(b.gamma_n) || on(a.gamma_t) != on(b.gamma_t) ||
@@ -176,7 +177,7 @@ class CortexModel {
     if (p.gravity != 0 && p.density_excess != 0) gravity_ = node_weights(cells);
     friction_ = FrictionOperator<Mem>(mesh_, node_drag(cells), p.dashpot, p.dashpot_transverse);
     if (p.has_plane) {
-      contact_ = ContactBuffers<Mem>(mesh_.n_tris);
+      contact_ = ContactBuffers<Mem>(mesh_.n_tris, p.contact.derjaguin);
       if (p.gamma_n > 0 || p.gamma_t > 0 || p.pin_friction > 0)
         enable_substrate_friction(friction_, *contact_, p.gamma_n, p.gamma_t, p.plane.normal, p.pin_friction,
                                   p.lumped_friction, p.area_friction_weights);
@@ -298,6 +299,12 @@ class CortexModel {
   double contact_power(std::vector<double>* per_cell = nullptr) const {
     if (per_cell) per_cell->assign(mesh_.n_cells, 0.0);
     return contact_ ? dcm::contact_power(space_, mesh_, params_.plane, *contact_, velocity_, per_cell) : 0.0;
+  }
+  // The adhesion energy of contact.law = "derjaguin" (J; 0 for the paper's Maugis–Dugdale pressure, which is
+  // not the gradient of an energy). energy() leaves it out: spread balances it as the contact power.
+  double adhesion_energy(std::vector<double>* per_cell = nullptr) const {
+    if (per_cell) per_cell->assign(mesh_.n_cells, 0.0);
+    return contact_ ? derjaguin_energy(space_, mesh_, params_.plane, contact_params_.table(), per_cell) : 0.0;
   }
   double contact_area(std::vector<double>* per_cell = nullptr) const {  // Σ A^C_t
     if (per_cell) per_cell->assign(mesh_.n_cells, 0.0);

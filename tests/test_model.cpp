@@ -356,6 +356,50 @@ MechanicsParams on_plane(double r, double a) {
   return p;
 }
 
+// contact.law = "derjaguin" (kernels/derjaguin_adhesion.hpp): the adhesion is an energy, so in the overdamped
+// flow the total energy (cortex + adhesion) never increases and falls at the rate vᵀΓv up to forward Euler's
+// O(Δt); the contact power the spread app balances (in-plane forces included) is −dE_adhesion/dt; the
+// contact grows.
+TEST(CortexModel, DerjaguinAdhesionIsConservative) {
+  const double r = 3.25e-6;
+  MechanicsParams p = on_plane(r, 0.3e-6);
+  p.pin_friction = 0;
+  p.contact.derjaguin = true;
+  p.contact.material.h0 = 100e-9;  // resolves the 162-node mesh's contact line (docs/model/contact_line.md)
+  CortexModel<Exec> model(Exec(), {HostCell(make_icosphere(2, r))}, p);
+  CgSettings cg;
+  cg.abs_tol = 0;
+  cg.rel_tol = 1e-12;
+  const double dt = 6e-6;
+  double e_prev = model.energy() + model.adhesion_energy();
+  const double e_start = e_prev, adh_start = model.adhesion_energy();
+  model.compute_forces();
+  const double area_start = model.contact_area();
+  EXPECT_LT(adh_start, 0.0);
+  double worst = 0, worst_power = 0;
+  for (int step = 0; step < 300; ++step) {
+    model.compute_forces();
+    model.solve_velocity(cg);
+    const double dissipation = model.dissipation(), power = model.contact_power();
+    const double adh0 = model.adhesion_energy();
+    model.advance(dt);
+    const double adh = model.adhesion_energy(), e = model.energy() + adh;
+    EXPECT_LE(e, e_prev) << "step " << step;
+    worst = std::fmax(worst, std::fabs((e - e_prev) / dt + dissipation) / dissipation);
+    worst_power = std::fmax(worst_power, std::fabs((adh - adh0) / dt + power) / dissipation);
+    e_prev = e;
+  }
+  model.compute_forces();
+  std::printf(
+      "  total energy %.4g J -> %.4g J; max |dE/dt + v'Gv| / v'Gv = %.3g; max |dE_adh/dt + P_c| / v'Gv"
+      " = %.3g; contact area %.3g -> %.3g um^2\n",
+      e_start, e_prev, worst, worst_power, area_start * 1e12, model.contact_area() * 1e12);
+  EXPECT_LT(e_prev, e_start);
+  EXPECT_LT(worst, 0.05);
+  EXPECT_LT(worst_power, 0.05);
+  EXPECT_GT(model.contact_area(), 1.03 * area_start);  // (1.06 × in these 1.8 ms)
+}
+
 TEST(CortexModel, CellOnAnAdhesivePlane) {
   const double r = 3.25e-6, a = 0.2e-6, pi = 3.14159265358979323846;
   const MechanicsParams p = on_plane(r, a);

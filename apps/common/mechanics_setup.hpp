@@ -48,6 +48,7 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
     p.contact.quadrature_points = static_cast<int>(scene.get_int("contact.quadrature_points"));
     p.contact.projected_area = scene.get_string("contact.quadrature_area") == "projected";
     p.contact.friction_on_adhesive_zone = scene.get_string("contact.friction_zone") == "adhesive";
+    p.contact.derjaguin = scene.get_string("contact.law") == "derjaguin";
     p.gamma_n = scene.get_real("contact.gamma_n_N_s_per_m3");
     p.gamma_t = scene.get_real("contact.gamma_t_N_s_per_m3");
     p.pin_friction = scene.get_real("contact.pin_friction_N_s_per_m");
