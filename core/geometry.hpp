@@ -46,9 +46,10 @@ struct GeometryBuffers {
   }
 };
 
-// Everything above from mesh.x, in dependency order. h_min: lower clamp of H_t (1/m), > 0.
+// Everything above from mesh.x, in dependency order. h_min: lower clamp of H_t (1/m), > 0. rounded = false:
+// without the curvature and the spheres (core/update_geometry.hpp).
 template <class ExecutionSpace, class MemorySpace>
 void update_geometry(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                     const GeometryBuffers<MemorySpace>& geo, double h_min);
+                     const GeometryBuffers<MemorySpace>& geo, double h_min, bool rounded = true);
 
 }  // namespace dcm

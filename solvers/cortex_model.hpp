@@ -176,6 +176,7 @@ class CortexModel {
     if (global_ && global_->volume && p.precondition_volume) woodbury_ = GlobalWoodbury<Mem>(mesh_);
     if (p.gravity != 0 && p.density_excess != 0) gravity_ = node_weights(cells);
     friction_ = FrictionOperator<Mem>(mesh_, node_drag(cells), p.dashpot, p.dashpot_transverse);
+    rounded_geometry_ = p.has_plane && !p.contact.derjaguin;
     if (p.has_plane) {
       contact_ = ContactBuffers<Mem>(mesh_.n_tris, p.contact.derjaguin);
       if (p.gamma_n > 0 || p.gamma_t > 0 || p.pin_friction > 0)
@@ -203,12 +204,21 @@ class CortexModel {
   const FrictionOperator<Mem>& friction() const { return friction_; }
   // Each cell's part of the last velocity solve (iterations, residual, convergence): the CG is per cell.
   const std::vector<CgResult>& cell_solves() const { return cg_.segment_results; }
+  // The node normals, areas and curvatures and the rounded triangles' spheres of the current positions,
+  // which compute_forces() leaves out unless the paper's contact law needs them (a no-op then).
+  void refresh_curvature() const {
+    if (rounded_geometry_) return;
+    compute_node_curvature(space_, mesh_, geo_);
+    compute_triangle_curvature(space_, mesh_, geo_, params_.h_min);
+    compute_rounded_triangles(space_, mesh_, geo_);
+  }
   // Per-triangle contact results of the last compute_forces() (empty without a plane).
   const std::optional<ContactBuffers<Mem>>& contact() const { return contact_; }
   // Per-node tension (eq. 1), stretch, normal force and pressure of the current state (compute_forces()
   // first); needs the bond term.
   void node_fields(const NodeFields<Mem>& out) const {
     if (!bonds_) throw std::logic_error("node_fields() needs the FENE+POW bond term");
+    refresh_curvature();
     compute_node_fields(space_, mesh_, geo_, *bonds_, bond_params_.table(), force_, out);
   }
   // The state a step of a cell starts from: its positions and last velocity (the warm start of the next
@@ -239,7 +249,7 @@ class CortexModel {
   void restore_cell_state(const Checkpoint& c, int cell) {
     set_cell_slice(mesh_.x, cell, c.array("model.x"));
     set_cell_slice(velocity_, cell, c.array("model.v"));
-    update_geometry(space_, mesh_, geo_, params_.h_min);
+    update_geometry(space_, mesh_, geo_, params_.h_min, rounded_geometry_);
   }
   // Rest-state edits for shape finding (apps/deflate): every cell's target volume times `factor` (no-op
   // without a volume term), and flat hinges (θ* = 0: no spontaneous curvature; no-op without bending).
@@ -317,7 +327,7 @@ class CortexModel {
 
   // Geometry, then the total force on every node.
   void compute_forces() {
-    update_geometry(space_, mesh_, geo_, params_.h_min);
+    update_geometry(space_, mesh_, geo_, params_.h_min, rounded_geometry_);
     Kokkos::deep_copy(space_, force_, 0.0);
     if (membrane_) {  // all four membrane terms in three passes (kernels/membrane_forces.hpp)
       Kokkos::deep_copy(space_, overstretched_, -1);
@@ -356,7 +366,7 @@ class CortexModel {
   // per_cell (optional): each cell's energy, the same terms added in the same order (a batch's cell gets
   // the bits it gets alone).
   double energy(std::vector<double>* per_cell = nullptr) {
-    update_geometry(space_, mesh_, geo_, params_.h_min);
+    update_geometry(space_, mesh_, geo_, params_.h_min, rounded_geometry_);
     std::vector<double> term;
     std::vector<double>* out = per_cell ? &term : nullptr;
     const auto add = [&](double total, double& e) {
@@ -690,6 +700,9 @@ class CortexModel {
   std::optional<TensionStiffness<Mem>> tension_stiffness_;
   std::optional<Vector> gravity_;
   std::optional<ContactBuffers<Mem>> contact_;
+  // The curvature and the rounded triangles' spheres are updated each step only for the paper's contact law
+  // (core/update_geometry.hpp); refresh_curvature() brings them up to date for output.
+  bool rounded_geometry_ = true;
   FrictionOperator<Mem> friction_;
   CgWorkspace<Mem> cg_;
 };

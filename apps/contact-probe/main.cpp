@@ -45,6 +45,8 @@ void probe(const std::string& path, const std::vector<std::string>& sets, bool a
                                dcm::mechanics_from_scene(scene));
   model.restore_cell_state(c, 0);
   model.compute_forces();
+  model.refresh_curvature();  // the spheres below (compute_forces() leaves them out for contact.law =
+                              // derjaguin)
   const auto x = host(model.positions());
   const auto tri = host(model.mesh().tri);
   const auto& geo = model.geometry();
