@@ -11,6 +11,9 @@
 //   distribution to the three nodes by the 3×3 solve of eq. 19 (kernels/contact_distribution.hpp).
 // The per-triangle results are kept (node loads, β weights for the substrate friction, contact area) and
 // gathered per node without atomics through the node → triangle-corner lists.
+// A cell with contact.law = "derjaguin" takes another branch per triangle: flat triangles with the exact
+// gradient of the Derjaguin energy (kernels/derjaguin_adhesion.hpp, docs/model/contact_line.md), which adds
+// in-plane node forces (tri_node_shear).
 #include "core/cell_params.hpp"
 #include "core/geometry.hpp"
 #include "core/vec3.hpp"
