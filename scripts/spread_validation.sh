@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The spreading runs behind docs/VALIDATION.md ("Spreading"): the paper scenes, the 642-node Hategan case
-# for the mesh comparison, and one run per direction of the paper's Figure 5, in two queues of one thread
+# for the mesh comparison, one run per direction of the paper's Figure 5 and two with the contact-line law, in
+# two queues of one thread
 # each (2 cores). Output: out/validation/<run>/ (each a spread output folder). Takes about an hour.
 # (The full paper scenes: build/bin/spread scenes/<scene>.toml.)
 #   bash scripts/spread_validation.sh [QUEUE]    # QUEUE = 1, 2 or both (default)
@@ -34,6 +35,9 @@ queue2() {
   run fig5_k_b_x2 "${fig5[@]}" --set cortex.k_b_J=480e-21
   run fig5_x_max_2.5 "${fig5[@]}" --set cortex.x_max=2.5
   run fig5_k_a_2e-3 "${fig5[@]}" --set cortex.k_a=2e-3
+  # dcm's contact-line law (docs/VALIDATION.md, "Spreading, session 13"): 10242 nodes, ~2 min.
+  run hategan2004_contact_line scenes/hategan2004_contact_line.toml
+  run cuvelier2007_derjaguin scenes/cuvelier2007.toml --set time.adaptive=true --set contact.law=derjaguin --early-window-s 2,20
 }
 case "${1:-both}" in
   1) queue1 ;;
