@@ -1,8 +1,7 @@
 #!/usr/bin/env bash
 # The spreading runs behind docs/VALIDATION.md ("Spreading"): the paper scenes, the 642-node Hategan case
 # for the mesh comparison, one run per direction of the paper's Figure 5 and two with the contact-line law, in
-# two queues of one thread
-# each (2 cores). Output: out/validation/<run>/ (each a spread output folder). Takes about an hour.
+# two queues of one thread each (2 cores). Output: out/validation/<run>/ (each a spread output folder). Takes about an hour.
 # (The full paper scenes: build/bin/spread scenes/<scene>.toml.)
 #   bash scripts/spread_validation.sh [QUEUE]    # QUEUE = 1, 2 or both (default)
 set -euo pipefail
