@@ -9,10 +9,7 @@
 #include <memory>
 
 #include "core/h5_links.hpp"
-
-#ifndef DCM_VERSION
-#define DCM_VERSION "0.1.0"
-#endif
+#include "dcm_config.hpp"  // DCM_VERSION
 
 namespace dcm {
 namespace {

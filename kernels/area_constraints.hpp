@@ -69,15 +69,14 @@ void add_area_forces_impl(const ExecutionSpace& space, const MeshBuffers<MemoryS
       KOKKOS_LAMBDA(const int i) {
         const int cell = node_cell(i);
         double global = 0;  // eq. 28: k_d (A_c - A_c*) / A_c*, the same for every triangle of the cell
-        if constexpr (Global)
+        if (Global)         // (not if constexpr: CUDA lambdas may not first-capture inside one)
           global =
               cell_value(k_d_cells, cell) * (cell_area(cell) - rest_cell_area(cell)) / rest_cell_area(cell);
         Real3 f{0, 0, 0};
         for (int s = offsets(i); s < offsets(i + 1); ++s) {
           const int t = corners(s) / 3, c = corners(s) % 3;
           double coef = global;
-          if constexpr (Local)
-            coef += cell_value(k_a_cells, cell) * (area(t) - rest_area(t)) / rest_area(t);   // eq. 27
+          if (Local) coef += cell_value(k_a_cells, cell) * (area(t) - rest_area(t)) / rest_area(t);  // eq. 27
           const Real3 edge = load3(x, tri(t, (c + 2) % 3)) - load3(x, tri(t, (c + 1) % 3));  // x_k - x_j
           f += (-0.5 * coef) * cross(load3(normal, t), edge);  // -coef dA_t/dx_i
         }

@@ -10,16 +10,27 @@ case "$preset" in
   release) builddir=build kokkos_variant=release ;;
   debug) builddir=build-debug kokkos_variant=bounds-check ;;
   sanitize) builddir=build-sanitize kokkos_variant=release ;;
-  *) echo "scripts/build.sh: unknown preset '$preset' (release, debug, sanitize)" >&2; exit 2 ;;
+  cuda) builddir=build-cuda kokkos_variant=cuda ;;
+  *) echo "scripts/build.sh: unknown preset '$preset' (release, debug, sanitize, cuda)" >&2; exit 2 ;;
 esac
 # debug uses a Kokkos with bounds checking on every View access; sanitize the release Kokkos (ASan and UBSan
 # instrument dcm's own code; the bounds checks would make the sanitized suite ~100x slower than release).
+# cuda: Kokkos with CUDA (DCM_CUDA_ARCH, default AMPERE80; scripts/deps.sh), dcm compiled by its nvcc_wrapper.
 kokkos=$(DCM_KOKKOS_VARIANT=$kokkos_variant bash scripts/deps.sh | tail -n 1)
+extra=()
+if [ "$preset" = cuda ]; then
+  if [ -n "${CUDA_HOME:-}" ] && [ -x "$CUDA_HOME/bin/nvcc" ]; then export PATH="$CUDA_HOME/bin:$PATH"; fi
+  if ! command -v nvcc > /dev/null && [ -x /usr/local/cuda/bin/nvcc ]; then export PATH="/usr/local/cuda/bin:$PATH"; fi
+  if [ -z "${NVCC_WRAPPER_DEFAULT_COMPILER:-}" ] && command -v g++-11 > /dev/null; then
+    export NVCC_WRAPPER_DEFAULT_COMPILER=g++-11  # nvcc 11.x takes host compilers up to GCC 11
+  fi
+  extra=("-DCMAKE_CXX_COMPILER=$kokkos/bin/nvcc_wrapper")
+fi
 # Configure when there is no build yet, or the preset, the Kokkos or CI-ness (warnings as errors) changed.
 stamp="$preset;$kokkos;ci=${CI:-false}"
 if [ ! -f "$builddir/CMakeCache.txt" ] || ! grep -qxF "DCM_CONFIGURED_FOR:STRING=$stamp" "$builddir/CMakeCache.txt"; then
   # -U Kokkos_DIR: a cached Kokkos_DIR from an earlier configure would win over the new Kokkos_ROOT.
-  cmake --preset "$preset" -U Kokkos_DIR -DKokkos_ROOT="$kokkos" "-DDCM_CONFIGURED_FOR:STRING=$stamp" >&2
+  cmake --preset "$preset" -U Kokkos_DIR -DKokkos_ROOT="$kokkos" "-DDCM_CONFIGURED_FOR:STRING=$stamp" "${extra[@]}" >&2
 fi
 # A named target that a changed CMakeLists.txt just added needs the build system regenerated first.
 if [ $# -gt 0 ] && [ -n "$(find . -name CMakeLists.txt -newer "$builddir/CMakeCache.txt" -not -path './build*' | head -n 1)" ]; then

@@ -37,19 +37,50 @@ fi
 
 # DCM_KOKKOS_VARIANT=bounds-check (scripts/build.sh debug|sanitize): the same Kokkos with bounds checking
 # on every View access, in its own prefix.
+# DCM_KOKKOS_VARIANT=cuda (scripts/build.sh cuda): Serial + OpenMP + CUDA for the GPU architecture
+# DCM_CUDA_ARCH (a Kokkos 3.4 arch name, default AMPERE80; VOLTA70, TURING75, AMPERE86, ...), compiled with
+# Kokkos' nvcc_wrapper. It needs nvcc: in $CUDA_HOME/bin, on PATH or in /usr/local/cuda/bin, from CUDA 11.x
+# (Kokkos 3.4.1 predates CUDA 12; with CUDA 12 or newer, or a Hopper GPU, point Kokkos_ROOT at a Kokkos 4.x).
 variant=${DCM_KOKKOS_VARIANT:-release}
+backends="Serial+OpenMP"
 case "$variant" in
   release) prefix="$cache/kokkos-3.4.1-openmp" variant_flags=() ;;
   bounds-check) prefix="$cache/kokkos-3.4.1-openmp-boundscheck" variant_flags=(-DKokkos_ENABLE_DEBUG_BOUNDS_CHECK=ON) ;;
-  *) log "error: DCM_KOKKOS_VARIANT = '$variant' is not allowed: choose release or bounds-check"; exit 2 ;;
+  cuda)
+    arch=${DCM_CUDA_ARCH:-AMPERE80}
+    case "$arch" in
+      KEPLER35 | MAXWELL50 | PASCAL60 | PASCAL61 | VOLTA70 | VOLTA72 | TURING75 | AMPERE80 | AMPERE86) ;;
+      *) log "error: DCM_CUDA_ARCH = '$arch' is not allowed: choose one of KEPLER35, MAXWELL50, PASCAL60, PASCAL61, VOLTA70, VOLTA72, TURING75, AMPERE80, AMPERE86 (Kokkos 3.4.1's names; a newer GPU runs AMPERE80 code)"; exit 2 ;;
+    esac
+    nvcc=""
+    [ -n "${CUDA_HOME:-}" ] && [ -x "$CUDA_HOME/bin/nvcc" ] && nvcc="$CUDA_HOME/bin/nvcc"
+    [ -z "$nvcc" ] && nvcc=$(command -v nvcc || true)
+    [ -z "$nvcc" ] && [ -x /usr/local/cuda/bin/nvcc ] && nvcc=/usr/local/cuda/bin/nvcc
+    if [ -z "$nvcc" ]; then
+      log "error: DCM_KOKKOS_VARIANT=cuda needs nvcc (the CUDA toolkit), and none is on PATH, in \$CUDA_HOME/bin or /usr/local/cuda/bin. On Debian 12: add 'non-free' to the apt components, then apt-get install nvidia-cuda-toolkit g++-11"
+      exit 2
+    fi
+    export PATH="$(dirname "$nvcc"):$PATH"
+    nvcc_major=$("$nvcc" --version | sed -n 's/.*release \([0-9]*\)\..*/\1/p')
+    if [ "${nvcc_major:-0}" -ge 12 ]; then
+      log "error: $nvcc is CUDA $nvcc_major; Kokkos 3.4.1 builds with CUDA 11.x only. Set CUDA_HOME to a CUDA 11 toolkit (Debian 12: nvidia-cuda-toolkit, CUDA_HOME=/usr), or point Kokkos_ROOT at your own Kokkos 4.x with CUDA"
+      exit 2
+    fi
+    # nvcc 11.x accepts host compilers up to GCC 11; Debian 12's default is GCC 12.
+    if [ -z "${NVCC_WRAPPER_DEFAULT_COMPILER:-}" ] && command -v g++-11 > /dev/null; then
+      export NVCC_WRAPPER_DEFAULT_COMPILER=g++-11
+    fi
+    prefix="$cache/kokkos-3.4.1-cuda-$arch" backends="Serial+OpenMP+CUDA ($arch)"
+    variant_flags=(-DKokkos_ENABLE_CUDA=ON -DKokkos_ENABLE_CUDA_LAMBDA=ON "-DKokkos_ARCH_$arch=ON") ;;
+  *) log "error: DCM_KOKKOS_VARIANT = '$variant' is not allowed: choose release, bounds-check or cuda"; exit 2 ;;
 esac
 if [ -f "$prefix/.dcm-complete" ]; then
-  log "Kokkos 3.4.1 (Serial+OpenMP, $variant): cached at $prefix"
+  log "Kokkos 3.4.1 ($backends, $variant): cached at $prefix"
   echo "$prefix"
   exit 0
 fi
 
-log "building Kokkos 3.4.1 (Serial+OpenMP, $variant) from Debian's trilinos source into $prefix"
+log "building Kokkos 3.4.1 ($backends, $variant) from Debian's trilinos source into $prefix"
 work=$(mktemp -d "${TMPDIR:-/tmp}/dcm-kokkos.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 # A private apt configuration that only knows a deb-src line: the system's apt set-up stays untouched.
@@ -64,6 +95,9 @@ tar -xf "$tarball" -C "$work/src" --wildcards '*/packages/kokkos/*'
 ksrc=$(ls -d "$work"/src/*/packages/kokkos | head -n 1)
 mkdir -p "$cache"
 buildlog="$cache/kokkos-3.4.1-$variant-build.log"
+# With CUDA, Kokkos and every code that includes it compile through Kokkos' nvcc_wrapper (installed to
+# $prefix/bin).
+[ "$variant" = cuda ] && variant_flags+=("-DCMAKE_CXX_COMPILER=$ksrc/bin/nvcc_wrapper")
 if ! { cmake -S "$ksrc" -B "$work/build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX="$prefix" \
          -DKokkos_ENABLE_SERIAL=ON -DKokkos_ENABLE_OPENMP=ON -DCMAKE_CXX_STANDARD=17 \
          -DCMAKE_POSITION_INDEPENDENT_CODE=ON -DBUILD_SHARED_LIBS=OFF "${variant_flags[@]}" &&

@@ -41,13 +41,13 @@ struct GlobalWoodbury {
         wr("dcm::woodbury::wr", mesh.n_cells) {}
 };
 
-// precondition(in, out): out = P in, for all cells (the caller's preconditioner, before this correction).
-// Needs g.volume (a cell set with a volume term).
-template <class ExecutionSpace, class MemorySpace, class Precondition>
-void update_global_woodbury(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                            const GlobalStiffness<MemorySpace>& g, const GlobalWoodbury<MemorySpace>& wb,
-                            const Precondition& precondition) {
-  precondition(g.grad_volume, wb.w);
+namespace woodbury_detail {
+// uᵀw per cell and the scales 1 / (1/coef + uᵀw), w = P u already stored in wb.w. Outside
+// update_global_woodbury: a CUDA extended lambda may not sit in a function templated on a type local to
+// another function (the caller's preconditioner lambda).
+template <class ExecutionSpace, class MemorySpace>
+void update_scales(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                   const GlobalStiffness<MemorySpace>& g, const GlobalWoodbury<MemorySpace>& wb) {
   const auto u = g.grad_volume, w = wb.w;
   segmented_sum<1>(
       "dcm::woodbury::uw", space, mesh.node_sums,
@@ -59,6 +59,17 @@ void update_global_woodbury(const ExecutionSpace& space, const MeshBuffers<Memor
       KOKKOS_LAMBDA(const int c) {  // a cell without the term (k_v = 0) takes no correction
         scale(c) = coef(c) > 0 ? 1.0 / (1.0 / coef(c) + uw(c)) : 0.0;
       });
+}
+}  // namespace woodbury_detail
+
+// precondition(in, out): out = P in, for all cells (the caller's preconditioner, before this correction).
+// Needs g.volume (a cell set with a volume term).
+template <class ExecutionSpace, class MemorySpace, class Precondition>
+void update_global_woodbury(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                            const GlobalStiffness<MemorySpace>& g, const GlobalWoodbury<MemorySpace>& wb,
+                            const Precondition& precondition) {
+  precondition(g.grad_volume, wb.w);
+  woodbury_detail::update_scales(space, mesh, g, wb);
 }
 
 // z −= w (wᵀ r) / (1/s + uᵀw), for the rows of the active cells (z = P r on entry).

@@ -124,6 +124,54 @@ inline CgResult combine(const std::vector<CgResult>& seg) {
   return all;
 }
 
+// The kernels of pcg_solve, outside it: a CUDA extended lambda may not sit in a function whose template
+// arguments are types local to another function (the host-side apply and precondition lambdas).
+// r = b − q and ||r||² per segment (into plan.result).
+template <class ExecutionSpace, class MemorySpace, class Vector>
+void residual_and_norms(const ExecutionSpace& space, const SumPlan<MemorySpace>& plan, const Vector& b,
+                        const Vector& q, const Vector& r) {
+  segmented_sum<1>(
+      "dcm::cg::initial_residual", space, plan,
+      KOKKOS_LAMBDA(const int i, double(&s)[1]) {
+        for (int d = 0; d < 3; ++d) {
+          r(i, d) = b(i, d) - q(i, d);
+          s[0] += r(i, d) * r(i, d);
+        }
+      },
+      plan.result);
+}
+
+// x += α p, r −= α q with each node's segment's α (0: the segment is frozen), and ||r||² per segment.
+template <class ExecutionSpace, class MemorySpace, class Vector, class Scalars, class Segments>
+void update_iterate(const ExecutionSpace& space, const SumPlan<MemorySpace>& plan, const Segments& seg,
+                    const Scalars& alpha, const Vector& p, const Vector& q, const Vector& x,
+                    const Vector& r) {
+  segmented_sum<1>(
+      "dcm::cg::update", space, plan,
+      KOKKOS_LAMBDA(const int i, double(&s)[1]) {
+        const double a = alpha(seg(i));
+        if (a != 0)  // a frozen segment keeps its x and r
+          for (int d = 0; d < 3; ++d) {
+            x(i, d) += a * p(i, d);
+            r(i, d) -= a * q(i, d);
+          }
+        for (int d = 0; d < 3; ++d) s[0] += r(i, d) * r(i, d);
+      },
+      plan.result);
+}
+
+// p = z + β p with each node's segment's β.
+template <class ExecutionSpace, class Vector, class Scalars, class Segments>
+void next_direction(const ExecutionSpace& space, const Segments& seg, const Scalars& beta, const Vector& z,
+                    const Vector& p) {
+  Kokkos::parallel_for(
+      "dcm::cg::direction", Kokkos::RangePolicy<ExecutionSpace>(space, 0, static_cast<int>(p.extent(0))),
+      KOKKOS_LAMBDA(const int i) {
+        const double bt = beta(seg(i));
+        for (int d = 0; d < 3; ++d) p(i, d) = z(i, d) + bt * p(i, d);
+      });
+}
+
 }  // namespace cg_detail
 
 // frozen (optional, one flag per segment): segments whose x is kept as it is (a batch's cells that are not
@@ -132,8 +180,6 @@ template <class ExecutionSpace, class Vector, class Apply, class Precondition, c
 CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& precondition, const Vector& b,
                    const Vector& x, Workspace& w, const CgSettings& settings,
                    const std::vector<char>* frozen = nullptr) {
-  using Policy = Kokkos::RangePolicy<ExecutionSpace>;
-  const int n = static_cast<int>(b.extent(0));
   const int n_seg = w.n_segments();
   const auto r = w.r, z = w.z, p = w.p, q = w.q;
   const auto seg = w.node_segment;
@@ -152,15 +198,7 @@ CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& pr
 
   cg_detail::segment_dots(space, sums, b, b, bb);
   apply(x, q);  // r = b - Γ x
-  segmented_sum<1>(
-      "dcm::cg::initial_residual", space, sums,
-      KOKKOS_LAMBDA(const int i, double(&s)[1]) {
-        for (int d = 0; d < 3; ++d) {
-          r(i, d) = b(i, d) - q(i, d);
-          s[0] += r(i, d) * r(i, d);
-        }
-      },
-      sums.result);
+  cg_detail::residual_and_norms(space, sums, b, q, r);
   Kokkos::deep_copy(space, sums.result_host, sums.result);
   space.fence();
   n_active = 0;
@@ -187,18 +225,7 @@ CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& pr
     cg_detail::segment_dots(space, sums, p, q, pq);
     for (int s = 0; s < n_seg; ++s) w.alpha_host(s) = active[s] ? rz[s] / pq[s] : 0.0;
     Kokkos::deep_copy(space, alpha, w.alpha_host);
-    segmented_sum<1>(
-        "dcm::cg::update", space, sums,
-        KOKKOS_LAMBDA(const int i, double(&s)[1]) {
-          const double a = alpha(seg(i));
-          if (a != 0)  // a frozen segment keeps its x and r
-            for (int d = 0; d < 3; ++d) {
-              x(i, d) += a * p(i, d);
-              r(i, d) -= a * q(i, d);
-            }
-          for (int d = 0; d < 3; ++d) s[0] += r(i, d) * r(i, d);
-        },
-        sums.result);
+    cg_detail::update_iterate(space, sums, seg, alpha, p, q, x, r);
     Kokkos::deep_copy(space, sums.result_host, sums.result);
     space.fence();
     bool stopped = false;
@@ -222,11 +249,7 @@ CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& pr
       if (active[s]) rz[s] = rz_new[s];
     }
     Kokkos::deep_copy(space, beta, w.beta_host);
-    Kokkos::parallel_for(
-        "dcm::cg::direction", Policy(space, 0, n), KOKKOS_LAMBDA(const int i) {
-          const double bt = beta(seg(i));
-          for (int d = 0; d < 3; ++d) p(i, d) = z(i, d) + bt * p(i, d);
-        });
+    cg_detail::next_direction(space, seg, beta, z, p);
   }
   return cg_detail::combine(res);
 }

@@ -153,6 +153,18 @@ struct DeflationWorkspace {
         u(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::rigid::u"), n) {}
 };
 
+namespace rigid_detail {
+// out = a + s b on [n][3] Views (out may alias a or b). Outside apply_rigid_deflated: a CUDA extended lambda
+// may not sit in a function templated on a type local to another function (the caller's inner lambda).
+template <class ExecutionSpace, class Vector>
+void add_scaled(const ExecutionSpace& space, const char* label, const Vector& a, double s, const Vector& b,
+                const Vector& out) {
+  Kokkos::parallel_for(
+      label, Kokkos::RangePolicy<ExecutionSpace>(space, 0, static_cast<int>(out.extent(0))),
+      KOKKOS_LAMBDA(const int i) { store3(out, i, load3(a, i) + s * load3(b, i)); });
+}
+}  // namespace rigid_detail
+
 template <class ExecutionSpace, class MemorySpace, class Inner>
 void apply_rigid_deflated(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                           const FrictionOperator<MemorySpace>& op, const RigidModes<MemorySpace>& rm,
@@ -160,20 +172,14 @@ void apply_rigid_deflated(const ExecutionSpace& space, const MeshBuffers<MemoryS
                           const typename FrictionOperator<MemorySpace>::Vector& r,
                           const typename FrictionOperator<MemorySpace>::Vector& z) {
   const auto y = w.y, t = w.t, u = w.u;
-  apply_rigid_coarse(space, mesh, rm, r, y, false);  // y = Q r
-  apply_friction(space, mesh, op, y, t);
-  Kokkos::parallel_for(
-      "dcm::rigid::deflate", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
-      KOKKOS_LAMBDA(const int i) { store3(t, i, load3(r, i) - load3(t, i)); });  // t = (I − ΓQ) r
-  inner(t, z);                                                                   // z = V t
-  apply_friction(space, mesh, op, z, u);                                         // u = Γ z
-  Kokkos::parallel_for(
-      "dcm::rigid::combine", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
-      KOKKOS_LAMBDA(const int i) { store3(z, i, load3(z, i) + load3(y, i)); });  // z = Q r + V t
-  apply_rigid_coarse(space, mesh, rm, u, t, false);                              // t = QΓ V t
-  Kokkos::parallel_for(
-      "dcm::rigid::project", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
-      KOKKOS_LAMBDA(const int i) { store3(z, i, load3(z, i) - load3(t, i)); });
+  apply_rigid_coarse(space, mesh, rm, r, y, false);                       // y = Q r
+  apply_friction(space, mesh, op, y, t);                                  //
+  rigid_detail::add_scaled(space, "dcm::rigid::deflate", r, -1.0, t, t);  // t = (I − ΓQ) r
+  inner(t, z);                                                            // z = V t
+  apply_friction(space, mesh, op, z, u);                                  // u = Γ z
+  rigid_detail::add_scaled(space, "dcm::rigid::combine", z, 1.0, y, z);   // z = Q r + V t
+  apply_rigid_coarse(space, mesh, rm, u, t, false);                       // t = QΓ V t
+  rigid_detail::add_scaled(space, "dcm::rigid::project", z, -1.0, t, z);
 }
 
 }  // namespace dcm

@@ -57,6 +57,40 @@ struct StepReport {
   double error_m = 0;          // adaptive: the error estimate of the previous step (m)
 };
 
+namespace stepper_detail {
+// The stepper's kernels as free functions: a CUDA extended lambda may not sit in a private member function.
+
+// Per segment (cell), max_i |a_i − b_i|² over its nodes, into m (host).
+template <class ExecutionSpace, class Plan, class Vector>
+void max_squared_difference(const ExecutionSpace& space, const Plan& sums, const Vector& a, const Vector& b,
+                            std::vector<double>& m) {
+  segmented_max(
+      "dcm::batch::max_velocity_change", space, sums,
+      KOKKOS_LAMBDA(const int i) {
+        const double dx = a(i, 0) - b(i, 0), dy = a(i, 1) - b(i, 1), dz = a(i, 2) - b(i, 2);
+        return dx * dx + dy * dy + dz * dz;
+      },
+      m);
+}
+
+// On the nodes of the cells with flag(c) ≠ 0: out = u + f_c (v − w), or out = u where f_c = 0; w empty
+// stands for zero.
+template <class ExecutionSpace, class Cells, class Values, class Vector>
+void combine_nodes(const ExecutionSpace& space, const char* label, const Cells& node_cell, const Values& flag,
+                   const Values& f, const Vector& out, const Vector& u, const Vector& v, const Vector& w) {
+  const bool has_w = w.extent(0) > 0;
+  Kokkos::parallel_for(
+      label, Kokkos::RangePolicy<ExecutionSpace>(space, 0, out.extent(0)), KOKKOS_LAMBDA(const int i) {
+        const int c = node_cell(i);
+        if (flag(c) == 0) return;
+        const double fc = f(c);
+        for (int d = 0; d < 3; ++d)
+          out(i, d) = fc == 0 ? u(i, d) : u(i, d) + fc * (has_w ? v(i, d) - w(i, d) : v(i, d));
+      });
+}
+
+}  // namespace stepper_detail
+
 template <class ExecutionSpace>
 class TimeStepper {
  public:
@@ -305,13 +339,7 @@ class TimeStepper {
     const auto a = model.velocity();
     const auto b = v_prev_;
     std::vector<double> m;
-    segmented_max(
-        "dcm::batch::max_velocity_change", model.space(), model.mesh().node_sums,
-        KOKKOS_LAMBDA(const int i) {
-          const double dx = a(i, 0) - b(i, 0), dy = a(i, 1) - b(i, 1), dz = a(i, 2) - b(i, 2);
-          return dx * dx + dy * dy + dz * dz;
-        },
-        m);
+    stepper_detail::max_squared_difference(model.space(), model.mesh().node_sums, a, b, m);
     for (double& v : m) v = std::sqrt(v);
     return m;
   }
@@ -376,19 +404,8 @@ class TimeStepper {
       if (cells[c]) factor[c] = s[c];
     cell_s_.assign(factor);
     cell_on_.assign(std::vector<double>(cells.begin(), cells.end()));
-    const auto f = cell_s_.values;
-    const auto flag = cell_on_.values;
-    const auto node_cell = model.mesh().node_cell;
-    const bool has_w = w.extent(0) > 0;
-    Kokkos::parallel_for(
-        label, Kokkos::RangePolicy<ExecutionSpace>(model.space(), 0, out.extent(0)),
-        KOKKOS_LAMBDA(const int i) {
-          const int c = node_cell(i);
-          if (flag(c) == 0) return;
-          const double fc = f(c);
-          for (int d = 0; d < 3; ++d)
-            out(i, d) = fc == 0 ? u(i, d) : u(i, d) + fc * (has_w ? v(i, d) - w(i, d) : v(i, d));
-        });
+    stepper_detail::combine_nodes(model.space(), label, model.mesh().node_cell, cell_on_.values,
+                                  cell_s_.values, out, u, v, w);
   }
 
   TimeStepSettings settings_;

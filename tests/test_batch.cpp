@@ -99,7 +99,7 @@ TEST(Batch, CellsWithDifferentConstantsStepExactlyAsAlone) {
   TimeStepSettings s;  // the paper's fixed step: cell 1 halves its first step (a bond near d_max), cell 0 not
   s.dt = 6e-6;
   TimeStepper<Exec> tb(batch, s), t0(alone0, s), t1(alone1, s);
-  const CgSettings cg;
+  const CgSettings cg{};
   int halvings[2] = {0, 0};
   for (int k = 0; k < 40; ++k) {
     const std::vector<StepReport> rb =
@@ -136,7 +136,7 @@ TEST(Batch, EachCellTakesItsOwnAdaptiveStepsAsAlone) {
   s.adaptive = true;
   s.error_tol_m = 1e-9;
   const double t_end[2] = {4e-4, 2.5e-4};
-  const CgSettings cg;
+  const CgSettings cg{};
   // Alone: the single-run stepper.
   std::vector<std::vector<double>> alone_h(2), alone_x(2);
   int alone_rejections[2] = {0, 0}, alone_halvings[2] = {0, 0};

@@ -82,7 +82,7 @@ TEST(TriangleCurvature, RadiusNeverBelowCircumradius) {
 TEST(EvansFungCurvature, DimpleIsConcave) {
   // At the poles z = D a0 + (a1 - 2 a0) rho^2 / D + O(rho^4): both principal curvatures are
   // -2 (a1 - 2 a0) / D seen from outside, so H = -2 (a1 - 2 a0) / D = -0.4857 / um.
-  const EvansFungShape s;
+  const EvansFungShape s{};
   const HostMesh m = make_evans_fung(5, s);
   const auto g = test::compute_geometry(m, kHMin);
   const double expected = -2 * (s.a1 - 2 * s.a0) / s.diameter;

@@ -14,6 +14,7 @@
 
 #include "core/checkpoint.hpp"
 #include "core/h5_output.hpp"
+#include "dcm_config.hpp"
 
 namespace {
 

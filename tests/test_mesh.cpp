@@ -128,7 +128,7 @@ TEST(Icosphere, HasANodeAtEachPole) {
 }
 
 TEST(EvansFung, ProfileMatchesPublishedDimensions) {
-  const EvansFungShape s;  // D = 7.82 um
+  const EvansFungShape s{};  // D = 7.82 um
   EXPECT_NEAR(2 * s.half_thickness(0), 0.810e-6, 0.001e-6);
   // Maximum thickness 2.566 um at rho = 2.738 um: scan the profile.
   double best = 0, best_rho = 0;
@@ -142,7 +142,7 @@ TEST(EvansFung, ProfileMatchesPublishedDimensions) {
 }
 
 TEST(EvansFung, NodesLieOnTheProfile) {
-  const EvansFungShape s;
+  const EvansFungShape s{};
   const HostMesh m = make_evans_fung(4, s);
   EXPECT_EQ(m.nodes.size(), 2562u);
   for (const Vec3& x : m.nodes) {

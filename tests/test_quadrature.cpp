@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "dcm_config.hpp"
 #include "kernels/quadrature_rules.hpp"
 
 #ifndef DCM_SOURCE_DIR

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/scene.hpp"
+#include "dcm_config.hpp"
 
 #ifndef DCM_SOURCE_DIR
 #error "DCM_SOURCE_DIR must be defined to the repository root"

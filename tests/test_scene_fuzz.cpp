@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/scene.hpp"
+#include "dcm_config.hpp"
 
 namespace {
 

@@ -44,6 +44,7 @@
 #include "core/host_copy.hpp"
 #include "core/json_writer.hpp"
 #include "core/kokkos_compat.hpp"
+#include "dcm_config.hpp"
 #include "solvers/time_stepper.hpp"
 
 namespace dcm {

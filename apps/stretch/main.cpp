@@ -20,6 +20,7 @@
 #include "core/host_copy.hpp"
 #include "core/json_writer.hpp"
 #include "core/kokkos_compat.hpp"
+#include "dcm_config.hpp"
 #include "solvers/newton_equilibrium.hpp"
 
 namespace dcm {
@@ -119,6 +120,11 @@ void run(const AppOptions& options, const StretchOptions& so) {
   summary.write(out + "/summary.json");
   if (!options.quiet)
     std::printf("  wrote %s/series.csv, summary.json, stretch.h5 (%.1f s)\n", out.c_str(), wall);
+  if (!so.no_plot) {  // stretch.png against Mills 2004 and Suresh 2005 (../shared/data/stretching)
+    const std::string cmd = std::string(DCM_PYTHON3) + " '" + DCM_SOURCE_DIR + "/scripts/plot_stretch.py' '" +
+                            out + "'" + (options.quiet ? " > /dev/null" : "");
+    if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "stretch: plotting failed (%s)\n", cmd.c_str());
+  }
 }
 
 }  // namespace
