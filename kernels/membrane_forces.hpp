@@ -38,12 +38,12 @@
 namespace dcm {
 
 // Items per work item of the triangle and edge passes: 8 where the execution space runs on the host (SIMD
-// lanes), 1 on a device (CUDA, HIP, SYCL: one thread per item).
+// lanes), 1 on a device (CUDA, HIP, SYCL: one thread per item). Asked of the execution space, not of its
+// memory: a device space with host-accessible (managed) memory still runs one item per thread.
 template <class ExecutionSpace>
 struct MembraneLanes {
   static constexpr int value =
-      Kokkos::SpaceAccessibility<Kokkos::HostSpace, typename ExecutionSpace::memory_space>::accessible ? 8
-                                                                                                       : 1;
+      Kokkos::SpaceAccessibility<ExecutionSpace, Kokkos::HostSpace>::accessible ? 8 : 1;
 };
 
 // The slot of each (edge, hinge node) in its node's contiguous range of the scratch: the node's (hinge,
