@@ -581,6 +581,7 @@ class CortexModel {
   Vector node_weights(const std::vector<HostCell>& cells) {
     Vector w("dcm::model::gravity_force", mesh_.n_nodes);
     auto h = Kokkos::create_mirror_view(w);
+    Kokkos::deep_copy(h, 0.0);  // only z is written below
     const auto volume = to_host_vector(geo_.cell_volume);
     int i = 0;
     for (std::size_t c = 0; c < cells.size(); ++c) {
