@@ -80,19 +80,34 @@ if [ -f "$prefix/.dcm-complete" ]; then
   exit 0
 fi
 
-log "building Kokkos 3.4.1 ($backends, $variant) from Debian's trilinos source into $prefix"
 work=$(mktemp -d "${TMPDIR:-/tmp}/dcm-kokkos.XXXXXX")
 trap 'rm -rf "$work"' EXIT
-# A private apt configuration that only knows a deb-src line: the system's apt set-up stays untouched.
-mkdir -p "$work/apt/lists/partial" "$work/apt/cache/archives/partial" "$work/src"
-echo "deb-src http://deb.debian.org/debian bookworm main" > "$work/apt/sources.list"
-aptopts=(-o Dir::Etc::SourceList="$work/apt/sources.list" -o Dir::Etc::SourceParts=/dev/null
-  -o Dir::State::Lists="$work/apt/lists" -o Dir::Cache="$work/apt/cache" -o APT::Sandbox::User=root)
-apt-get "${aptopts[@]}" update -qq >&2
-(cd "$work/src" && apt-get "${aptopts[@]}" -qq source --download-only trilinos > /dev/null)
-tarball=$(ls "$work"/src/trilinos_*.orig.tar.* | head -n 1)
-tar -xf "$tarball" -C "$work/src" --wildcards '*/packages/kokkos/*'
-ksrc=$(ls -d "$work"/src/*/packages/kokkos | head -n 1)
+# The Kokkos source: DCM_KOKKOS_SRC (a Kokkos 3.4.1 source tree, for a machine without network), else the copy
+# kept in the cache by an earlier build, else Debian's trilinos source package (downloaded once).
+srccache="$cache/kokkos-3.4.1-src"
+if [ -n "${DCM_KOKKOS_SRC:-}" ]; then
+  [ -f "$DCM_KOKKOS_SRC/CMakeLists.txt" ] || { log "error: DCM_KOKKOS_SRC = '$DCM_KOKKOS_SRC' is not a Kokkos source tree (no CMakeLists.txt)"; exit 2; }
+  ksrc=$DCM_KOKKOS_SRC
+  log "building Kokkos 3.4.1 ($backends, $variant) from $ksrc into $prefix"
+elif [ -f "$srccache/CMakeLists.txt" ]; then
+  ksrc=$srccache
+  log "building Kokkos 3.4.1 ($backends, $variant) from the cached source $ksrc into $prefix"
+else
+  log "building Kokkos 3.4.1 ($backends, $variant) from Debian's trilinos source into $prefix"
+  # A private apt configuration that only knows a deb-src line: the system's apt set-up stays untouched.
+  mkdir -p "$work/apt/lists/partial" "$work/apt/cache/archives/partial" "$work/src"
+  echo "deb-src http://deb.debian.org/debian bookworm main" > "$work/apt/sources.list"
+  aptopts=(-o Dir::Etc::SourceList="$work/apt/sources.list" -o Dir::Etc::SourceParts=/dev/null
+    -o Dir::State::Lists="$work/apt/lists" -o Dir::Cache="$work/apt/cache" -o APT::Sandbox::User=root)
+  apt-get "${aptopts[@]}" update -qq >&2
+  (cd "$work/src" && apt-get "${aptopts[@]}" -qq source --download-only trilinos > /dev/null)
+  tarball=$(ls "$work"/src/trilinos_*.orig.tar.* | head -n 1)
+  tar -xf "$tarball" -C "$work/src" --wildcards '*/packages/kokkos/*'
+  mkdir -p "$cache"
+  rm -rf "$srccache.tmp" && cp -r "$(ls -d "$work"/src/*/packages/kokkos | head -n 1)" "$srccache.tmp" &&
+    mv "$srccache.tmp" "$srccache"
+  ksrc=$srccache
+fi
 mkdir -p "$cache"
 buildlog="$cache/kokkos-3.4.1-$variant-build.log"
 # With CUDA, Kokkos and every code that includes it compile through Kokkos' nvcc_wrapper (installed to
