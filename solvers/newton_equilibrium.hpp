@@ -7,6 +7,7 @@
 // equilibrium makes it far better than FIRE where the cell is stiff (strained FENE bonds under a load).
 //
 // Converged when max_i |F_i| ≤ force_tol (N).
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -21,6 +22,7 @@ struct NewtonSettings {
   double cg_rel_tol = 1e-3;  // inner solve: relative to |F| (inexact Newton)
   double mu_start = 0;       // N/m; 0: 1e-3 k_s
   int trace = 0;             // > 0: print every Newton step to stderr
+  double progress_s = 0;     // > 0: a progress line on stdout at most this often (wall seconds)
 };
 
 struct NewtonResult {
@@ -79,6 +81,11 @@ NewtonResult newton_equilibrium(CortexModel<ExecutionSpace>& model, const Newton
   double energy = model.energy();
   double mu = s.mu_start > 0 ? s.mu_start : 1e-3 * model.params().bonds.k_s;
   result.max_force = max_norm(f);
+  const auto started = std::chrono::steady_clock::now();
+  auto last_progress = started;
+  const auto seconds_since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  };
   while (result.newton_steps < s.max_newton_steps) {
     if (result.max_force <= s.force_tol) {
       result.converged = true;
@@ -132,6 +139,12 @@ NewtonResult newton_equilibrium(CortexModel<ExecutionSpace>& model, const Newton
       Kokkos::deep_copy(space, x, x0);
       model.compute_forces();
       ++result.force_evaluations;
+    }
+    if (s.progress_s > 0 && seconds_since(last_progress) >= s.progress_s) {
+      last_progress = std::chrono::steady_clock::now();
+      std::printf("  Newton step %d: largest node force %.3e N (target %.1e N), %.0f s\n",
+                  result.newton_steps, result.max_force, s.force_tol, seconds_since(started));
+      std::fflush(stdout);
     }
     if (s.trace > 0 && result.newton_steps % s.trace == 0)
       std::fprintf(stderr, "  Newton %d: max |F| = %.3e N, E = %.10e J, mu = %.2e, CG %d%s\n",

@@ -73,6 +73,7 @@ void run(const Options& o) {
   dcm::NewtonSettings ns;
   ns.force_tol = 1e-16;
   ns.max_newton_steps = 1000;
+  if (!o.quiet) ns.progress_s = 10;
   const double edge = 4.0 * scene.get_real("mesh.radius_m") / std::sqrt(static_cast<double>(o.nodes));
   const dcm::NewtonResult r = dcm::newton_equilibrium(model, ns, edge);
   if (!r.converged)
