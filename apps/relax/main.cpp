@@ -3,7 +3,8 @@
 // overdamped dynamics with the bond dashpots. The relaxation time t_c is fitted to Hochmuth's form
 //   (λ − λ∞)/(λ + λ∞) = [(λ₀ − λ∞)/(λ₀ + λ∞)] exp(−t/t_c),  λ = D_A/D_T,
 // with λ∞ the ratio of the unstressed shape. Writes <out>/series.csv (t_s,DA_m,DT_m,energy_J,
-// dissipation_W,cg_iterations), <out>/summary.json (relaxation_time_s, ...), <out>/relax.h5 (+ .xmf).
+// dissipation_W,cg_iterations), <out>/summary.json (relaxation_time_s, ...), <out>/relax.h5 (+ .xmf) and
+// <out>/relax.png (scripts/plot_relax.py).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +19,7 @@
 #include "core/host_copy.hpp"
 #include "core/json_writer.hpp"
 #include "core/kokkos_compat.hpp"
+#include "dcm_config.hpp"
 #include "solvers/newton_equilibrium.hpp"
 
 namespace dcm {
@@ -30,6 +32,7 @@ struct RelaxOptions {
   double duration_s = 0.6;
   int sample_every = 100;          // steps between samples of the series
   double pulled_fraction = 0.025;  // per end, as in stretch
+  bool no_plot = false;
 };
 
 // Least-squares slope of log(y) against t over the samples with y > floor; returns −1/slope.
@@ -158,6 +161,11 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
   if (!options.quiet)
     std::printf("  relaxation time t_c = %.4g s; mean CG iterations %.1f (max %d); %.1f s\n", tc,
                 static_cast<double>(cg_total) / (steps + 1), cg_max, wall);
+  if (!ro.no_plot) {  // relax.png: D_A(t), D_T(t) and the fit
+    const std::string cmd = std::string(DCM_PYTHON3) + " '" + DCM_SOURCE_DIR + "/scripts/plot_relax.py' '" +
+                            out + "'" + (options.quiet ? " > /dev/null" : "");
+    if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "relax: plotting failed (%s)\n", cmd.c_str());
+  }
 }
 
 }  // namespace
@@ -177,6 +185,7 @@ int main(int argc, char** argv) {
   app.add_option("--pulled-fraction", ro.pulled_fraction,
                  "Fraction of all nodes held at each end (default 0.025: 5% of the nodes in total)")
       ->check(CLI::Range(0.001, 0.25));
+  app.add_flag("--no-plot", ro.no_plot, "Do not draw relax.png");
   app.add_option("--sample-every", ro.sample_every, "Steps between rows of series.csv")
       ->check(CLI::Range(1, 1000000));
   return dcm::run_app(app, argc, argv, [&] { dcm::run(options, ro); });
