@@ -19,11 +19,8 @@ esac
 kokkos=$(DCM_KOKKOS_VARIANT=$kokkos_variant bash scripts/deps.sh | tail -n 1)
 extra=()
 if [ "$preset" = cuda ]; then
-  if [ -n "${CUDA_HOME:-}" ] && [ -x "$CUDA_HOME/bin/nvcc" ]; then export PATH="$CUDA_HOME/bin:$PATH"; fi
-  if ! command -v nvcc > /dev/null && [ -x /usr/local/cuda/bin/nvcc ]; then export PATH="/usr/local/cuda/bin:$PATH"; fi
-  if [ -z "${NVCC_WRAPPER_DEFAULT_COMPILER:-}" ] && command -v g++-11 > /dev/null; then
-    export NVCC_WRAPPER_DEFAULT_COMPILER=g++-11  # nvcc 11.x takes host compilers up to GCC 11
-  fi
+  source scripts/cuda_env.sh
+  dcm_cuda_env
   extra=("-DCMAKE_CXX_COMPILER=$kokkos/bin/nvcc_wrapper")
 fi
 # Configure when there is no build yet, or the preset, the Kokkos or CI-ness (warnings as errors) changed.

@@ -52,23 +52,17 @@ case "$variant" in
       KEPLER35 | MAXWELL50 | PASCAL60 | PASCAL61 | VOLTA70 | VOLTA72 | TURING75 | AMPERE80 | AMPERE86) ;;
       *) log "error: DCM_CUDA_ARCH = '$arch' is not allowed: choose one of KEPLER35, MAXWELL50, PASCAL60, PASCAL61, VOLTA70, VOLTA72, TURING75, AMPERE80, AMPERE86 (Kokkos 3.4.1's names; a newer GPU runs AMPERE80 code)"; exit 2 ;;
     esac
-    nvcc=""
-    [ -n "${CUDA_HOME:-}" ] && [ -x "$CUDA_HOME/bin/nvcc" ] && nvcc="$CUDA_HOME/bin/nvcc"
-    [ -z "$nvcc" ] && nvcc=$(command -v nvcc || true)
-    [ -z "$nvcc" ] && [ -x /usr/local/cuda/bin/nvcc ] && nvcc=/usr/local/cuda/bin/nvcc
+    source "$(dirname "$0")/cuda_env.sh"
+    dcm_cuda_env
+    nvcc=$DCM_NVCC
     if [ -z "$nvcc" ]; then
       log "error: DCM_KOKKOS_VARIANT=cuda needs nvcc (the CUDA toolkit), and none is on PATH, in \$CUDA_HOME/bin or /usr/local/cuda/bin. On Debian 12: add 'non-free' to the apt components, then apt-get install nvidia-cuda-toolkit g++-11"
       exit 2
     fi
-    export PATH="$(dirname "$nvcc"):$PATH"
     nvcc_major=$("$nvcc" --version | sed -n 's/.*release \([0-9]*\)\..*/\1/p')
     if [ "${nvcc_major:-0}" -ge 12 ]; then
       log "error: $nvcc is CUDA $nvcc_major; Kokkos 3.4.1 builds with CUDA 11.x only. Set CUDA_HOME to a CUDA 11 toolkit (Debian 12: nvidia-cuda-toolkit, CUDA_HOME=/usr), or point Kokkos_ROOT at your own Kokkos 4.x with CUDA"
       exit 2
-    fi
-    # nvcc 11.x accepts host compilers up to GCC 11; Debian 12's default is GCC 12.
-    if [ -z "${NVCC_WRAPPER_DEFAULT_COMPILER:-}" ] && command -v g++-11 > /dev/null; then
-      export NVCC_WRAPPER_DEFAULT_COMPILER=g++-11
     fi
     prefix="$cache/kokkos-3.4.1-cuda-$arch" backends="Serial+OpenMP+CUDA ($arch)"
     variant_flags=(-DKokkos_ENABLE_CUDA=ON -DKokkos_ENABLE_CUDA_LAMBDA=ON "-DKokkos_ARCH_$arch=ON") ;;

@@ -173,7 +173,7 @@ void apply_rigid_deflated(const ExecutionSpace& space, const MeshBuffers<MemoryS
                           const typename FrictionOperator<MemorySpace>::Vector& z) {
   const auto y = w.y, t = w.t, u = w.u;
   apply_rigid_coarse(space, mesh, rm, r, y, false);                       // y = Q r
-  apply_friction(space, mesh, op, y, t);                                  //
+  apply_friction(space, mesh, op, y, t);                                  // t = Γ Q r
   rigid_detail::add_scaled(space, "dcm::rigid::deflate", r, -1.0, t, t);  // t = (I − ΓQ) r
   inner(t, z);                                                            // z = V t
   apply_friction(space, mesh, op, z, u);                                  // u = Γ z
