@@ -1,0 +1,81 @@
+#!/usr/bin/env python3
+"""Every command line the docs show must still be accepted: each `build/bin/APP ...` in README.md and
+docs/**/*.md names an existing app, each --flag it uses is one the app's --help lists, and each --set KEY is
+a scene key (spread --list-keys) whose documented value `spread --check` accepts, and each scenes/*.toml it
+names exists.
+Usage: check_doc_commands.py SOURCE_DIR BIN_DIR [DOC.md ...]   (default: README.md and docs/**/*.md)
+Exit 0 when every command holds, 1 listing each problem as FILE:LINE: what."""
+import pathlib, re, subprocess, sys
+
+src, bindir = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
+docs = [pathlib.Path(d).resolve() for d in sys.argv[3:]] or [src / "README.md"] + sorted((src / "docs").rglob("*.md"))
+# A command runs from `build/bin/APP` to the closing backtick of its code span (which may wrap lines).
+cmd_re = re.compile(r"build/bin/([A-Za-z_][A-Za-z0-9_-]*)([^`]*)")
+flag_re = re.compile(r"(?<![\w-])(--[a-z][a-z0-9-]*)")
+set_re = re.compile(r"--set[\s=]+([a-z_][a-z0-9_.]*)=([^\s\]`]*)")
+
+def is_command_head(before):
+    """True when what precedes build/bin/APP in its code span is only environment settings, `time` or
+    `timeout N`, after the start of the span or a shell separator."""
+    segment = re.split(r"[;&|(]", before)[-1].split()
+    words = [w for w in segment if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*=\S*", w)]
+    return all(w in ("time", "env", "timeout") or w.isdigit() for w in words)
+
+
+help_cache, problems, checked, pairs = {}, [], 0, {}
+def app_help(app):
+    if app not in help_cache:
+        exe = bindir / app
+        if not exe.exists():
+            help_cache[app] = None
+        else:
+            r = subprocess.run([str(exe), "--help"], capture_output=True, text=True, timeout=60)
+            help_cache[app] = r.stdout + r.stderr
+    return help_cache[app]
+
+keys_out = subprocess.run([str(bindir / "spread"), "--list-keys"], capture_output=True, text=True).stdout
+keys = set(re.findall(r"^\| `([a-z_0-9.]+)`", keys_out, re.M))
+if len(keys) < 20:
+    sys.exit(f"spread --list-keys gave {len(keys)} keys; cannot check")
+
+for doc in docs:
+    text = doc.read_text()
+    for span in re.finditer(r"`([^`]+)`", text, re.S):
+        spans = span.group(1)
+        for m in cmd_re.finditer(spans):
+            app, rest = m.group(1), m.group(2)
+            if not is_command_head(spans[: m.start()]):
+                continue  # build/bin/APP passed as an argument (e.g. to a script): not this app's options
+            rest = rest.split("build/bin/")[0]  # stop at the next command of a pipeline
+            where = f"{doc.name if not doc.is_relative_to(src) else doc.relative_to(src)}:{text.count(chr(10), 0, span.start(1) + m.start()) + 1}"
+            checked += 1
+            h = app_help(app)
+            if h is None:
+                problems.append(f"{where}: build/bin/{app} does not exist")
+                continue
+            gtest_or_bench = "--gtest_" in h or "--benchmark_" in h
+            for flag in flag_re.findall(rest):
+                if gtest_or_bench and (flag.startswith("--gtest_") or flag.startswith("--benchmark_")):
+                    continue
+                if not re.search(re.escape(flag) + r"(?![a-z0-9-])", h):
+                    problems.append(f"{where}: build/bin/{app} has no option {flag}")
+            for scene in re.findall(r"(?<![\w/.-])((?:scenes|tests)/[\w/.-]+\.toml)", rest):
+                if not (src / scene).exists():
+                    problems.append(f"{where}: {scene} does not exist")
+            for key, value in set_re.findall(rest):
+                if key not in keys:
+                    problems.append(f"{where}: --set {key}: not a scene key")
+                elif re.fullmatch(r"[-+.\w\"']+", value) and not re.fullmatch(r"[A-Z]+", value):
+                    pairs.setdefault((key, value), where)
+
+# The values: each documented KEY=VALUE (placeholders such as N or <run> left out) must pass spread --check.
+for (key, value), where in sorted(pairs.items()):
+    r = subprocess.run([str(bindir / "spread"), "--check", "--set", f"{key}={value}"], capture_output=True,
+                       text=True, timeout=60, cwd=src)
+    if r.returncode != 0:
+        problems.append(f"{where}: --set {key}={value}: {(r.stderr or r.stdout).strip()}")
+
+for p in problems:
+    print(p)
+print(f"{checked} documented commands checked, {len(problems)} problems")
+sys.exit(1 if problems or checked == 0 else 0)
