@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Every command line the docs show must still be accepted: each `build/bin/APP ...` in README.md and
-docs/**/*.md names an existing app, each --flag it uses is one the app's --help lists, and each --set KEY is
+docs/**/*.md, and each line under "Examples:" in an app's --help, names an existing app, each --flag it uses is one the app's --help lists, and each --set KEY is
 a scene key (spread --list-keys) whose documented value `spread --check` accepts, and each scenes/*.toml it
 names exists.
 Usage: check_doc_commands.py SOURCE_DIR BIN_DIR [DOC.md ...]   (default: README.md and docs/**/*.md)
@@ -38,6 +38,27 @@ keys = set(re.findall(r"^\| `([a-z_0-9.]+)`", keys_out, re.M))
 if len(keys) < 20:
     sys.exit(f"spread --list-keys gave {len(keys)} keys; cannot check")
 
+def check_command(app, rest, where):
+    h = app_help(app)
+    if h is None:
+        problems.append(f"{where}: build/bin/{app} does not exist")
+        return
+    gtest_or_bench = "--gtest_" in h or "--benchmark_" in h
+    for flag in flag_re.findall(rest):
+        if gtest_or_bench and (flag.startswith("--gtest_") or flag.startswith("--benchmark_")):
+            continue
+        if not re.search(re.escape(flag) + r"(?![a-z0-9-])", h):
+            problems.append(f"{where}: build/bin/{app} has no option {flag}")
+    for scene in re.findall(r"(?<![\w/.-])((?:scenes|tests)/[\w/.-]+\.toml)", rest):
+        if not (src / scene).exists():
+            problems.append(f"{where}: {scene} does not exist")
+    for key, value in set_re.findall(rest):
+        if key not in keys:
+            problems.append(f"{where}: --set {key}: not a scene key")
+        elif re.fullmatch(r"[-+.\w\"']+", value) and not re.fullmatch(r"[A-Z]+", value):
+            pairs.setdefault((key, value), where)
+
+
 for doc in docs:
     text = doc.read_text()
     for span in re.finditer(r"`([^`]+)`", text, re.S):
@@ -49,24 +70,22 @@ for doc in docs:
             rest = rest.split("build/bin/")[0]  # stop at the next command of a pipeline
             where = f"{doc.name if not doc.is_relative_to(src) else doc.relative_to(src)}:{text.count(chr(10), 0, span.start(1) + m.start()) + 1}"
             checked += 1
-            h = app_help(app)
-            if h is None:
-                problems.append(f"{where}: build/bin/{app} does not exist")
-                continue
-            gtest_or_bench = "--gtest_" in h or "--benchmark_" in h
-            for flag in flag_re.findall(rest):
-                if gtest_or_bench and (flag.startswith("--gtest_") or flag.startswith("--benchmark_")):
-                    continue
-                if not re.search(re.escape(flag) + r"(?![a-z0-9-])", h):
-                    problems.append(f"{where}: build/bin/{app} has no option {flag}")
-            for scene in re.findall(r"(?<![\w/.-])((?:scenes|tests)/[\w/.-]+\.toml)", rest):
-                if not (src / scene).exists():
-                    problems.append(f"{where}: {scene} does not exist")
-            for key, value in set_re.findall(rest):
-                if key not in keys:
-                    problems.append(f"{where}: --set {key}: not a scene key")
-                elif re.fullmatch(r"[-+.\w\"']+", value) and not re.fullmatch(r"[A-Z]+", value):
-                    pairs.setdefault((key, value), where)
+            check_command(app, rest, where)
+
+# The examples in the apps' own --help (only when checking the docs, not a fixture).
+if not sys.argv[3:]:
+    for exe in sorted(bindir.iterdir()):
+        if not (exe.is_file() and exe.stat().st_mode & 0o111) or exe.suffix:
+            continue
+        h = app_help(exe.name)
+        if "Examples:" not in h:
+            continue
+        for line in h.split("Examples:", 1)[1].splitlines()[1:]:
+            words = line.split(None, 1)
+            if not line.startswith("  ") or not words or words[0] != exe.name:
+                break
+            checked += 1
+            check_command(exe.name, words[1] if len(words) > 1 else "", f"{exe.name} --help")
 
 # The values: each documented KEY=VALUE (placeholders such as N or <run> left out) must pass spread --check.
 for (key, value), where in sorted(pairs.items()):

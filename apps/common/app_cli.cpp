@@ -8,17 +8,12 @@
 
 namespace dcm {
 
-void add_common_options(CLI::App& app, AppOptions& o) {
-  app.footer(
-      "Examples:\n"
-      "  " +
-      app.get_name() +
-      " scenes/default.toml\n"
-      "  " +
-      app.get_name() +
-      " scenes/evans_fung.toml --set mesh.nodes=10242 --out out/ef10k\n"
-      "Exit codes: 0 success, 2 bad input (nothing written), 3 numerical failure, 1 internal error.\n"
-      "Scene keys: --list-keys or docs/SCENES.md.");
+void add_common_options(CLI::App& app, AppOptions& o, const std::vector<std::string>& examples) {
+  std::string footer = "Examples:\n";
+  for (const std::string& e : examples) footer += "  " + app.get_name() + (e.empty() ? "" : " ") + e + "\n";
+  app.footer(footer +
+             "Exit codes: 0 success, 2 bad input (nothing written), 3 numerical failure, 1 internal error.\n"
+             "Scene keys: --list-keys or docs/SCENES.md.");
   app.add_option("scene", o.scene_path, "Scene file (TOML); without one the built-in defaults run")
       ->check(CLI::ExistingFile);
   app.add_option("--set", o.sets,
@@ -30,6 +25,8 @@ void add_common_options(CLI::App& app, AppOptions& o) {
   app.add_option("--threads", o.threads, "Host threads (default: OMP_NUM_THREADS, else all cores)")
       ->check(CLI::Range(0, 4096));
   app.add_flag("--quiet", o.quiet, "Print only errors");
+  app.add_flag("--check", o.check,
+               "Only check the scene and the options (exit 0, or 2 with the error); write and run nothing");
   app.add_flag_callback(
       "--list-keys",
       [] {
@@ -46,6 +43,13 @@ Scene load_scene(const AppOptions& o, const std::vector<std::string>& without_fi
   for (const std::string& s : o.sets) scene.set(s);
   scene.validate();
   return scene;
+}
+
+bool stop_after_check(const std::string& app, const AppOptions& o, const Scene& scene) {
+  if (!o.check) return false;
+  if (!o.quiet)
+    std::printf("%s: scene %s: ok (checked, nothing written)\n", app.c_str(), scene.name().c_str());
+  return true;
 }
 
 std::string prepare_output_dir(const AppOptions& o, const Scene& scene) {

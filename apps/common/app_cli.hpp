@@ -1,6 +1,6 @@
 #pragma once
 // What every dcm app shares on the command line:
-//   <app> [SCENE.toml] [--set key=value]... [--out DIR] [--threads N] [--quiet] [--list-keys]
+//   <app> [SCENE.toml] [--set key=value]... [--out DIR] [--threads N] [--quiet] [--list-keys] [--check]
 // and one policy for failures: a one-line message on stderr and an exit code
 //   2  bad input (command line, scene file, output folder), nothing written;
 //   3  numerical trouble during a run (step, term and node named);
@@ -27,9 +27,16 @@ struct AppOptions {
   std::string out_dir;            // empty: output.dir, else out/<name>
   int threads = 0;                // 0: OMP_NUM_THREADS or all cores
   bool quiet = false;
+  bool check = false;  // --check: validate the scene and the options, then stop before writing anything
 };
 
-void add_common_options(CLI::App& app, AppOptions& options);
+// Registers the shared options and the help's footer; `examples` are the app's own command lines
+// (without the app's name), shown under "Examples:".
+void add_common_options(CLI::App& app, AppOptions& options, const std::vector<std::string>& examples);
+
+// For --check: when it was given, prints "<app>: scene <name>: ok (checked, nothing written)" (unless
+// --quiet) and returns true; the app then returns before creating its output folder.
+bool stop_after_check(const std::string& app, const AppOptions& options, const Scene& scene);
 
 // The scene from the file (or the built-in defaults changed by `without_file`, e.g. an app's own
 // experiment), with every --set applied, validated. Throws SceneError.

@@ -37,6 +37,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 void run(const AppOptions& options) {
   const Scene scene = load_scene(options);
+  if (stop_after_check("geometry", options, scene)) return;
   const std::string out = prepare_output_dir(options, scene);
   KokkosSession kokkos(options.threads);
   using Exec = Kokkos::DefaultExecutionSpace;
@@ -169,6 +170,7 @@ int main(int argc, char** argv) {
       "triangles. Writes <out>/geometry.json, and <out>/geometry.h5 with geometry.xmf (ParaView).",
       "geometry");
   dcm::AppOptions options;
-  dcm::add_common_options(app, options);
+  dcm::add_common_options(app, options,
+                          {"scenes/evans_fung.toml", "--set mesh.nodes=10242 --out out/sphere10k"});
   return dcm::run_app(app, argc, argv, [&] { dcm::run(options); });
 }

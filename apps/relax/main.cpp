@@ -62,6 +62,7 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
   if (!(ro.duration_s > 0 && ro.duration_s <= 100))
     throw SceneError("--duration-s = " + std::to_string(ro.duration_s) +
                      " is out of range: allowed > 0 .. 100");
+  if (stop_after_check("relax", options, scene)) return;
   const std::string out = prepare_output_dir(options, scene);
   KokkosSession kokkos(options.threads);
   const auto wall0 = std::chrono::steady_clock::now();
@@ -179,7 +180,9 @@ int main(int argc, char** argv) {
       "relax");
   dcm::AppOptions options;
   dcm::RelaxOptions ro;
-  dcm::add_common_options(app, options);
+  dcm::add_common_options(app, options,
+                          {"", "--set mesh.nodes=642 --duration-s 0.6 --out out/relax642",
+                           "scenes/relax.toml --hold-force-pN 20"});
   app.add_option("--hold-force-pN", ro.hold_force_pN, "Force holding the cell before the release (pN)");
   app.add_option("--duration-s", ro.duration_s, "Simulated time after the release (s)");
   app.add_option("--pulled-fraction", ro.pulled_fraction,

@@ -816,7 +816,11 @@ int main(int argc, char** argv) {
       "spread");
   dcm::AppOptions options;
   dcm::SpreadOptions so;
-  dcm::add_common_options(app, options);
+  dcm::add_common_options(
+      app, options,
+      {"scenes/default.toml", "scenes/hategan2004_sphered.toml --out out/hategan",
+       "scenes/evans_fung.toml --set mesh.nodes=10242 --set time.t_end_s=0.5 --out out/ef10k",
+       "--restart out/hategan/checkpoint.h5 --set time.t_end_s=4"});
   app.add_flag(
       "--no-plot", [&](std::int64_t) { so.plot = false; }, "Do not write the PNG plots");
   std::vector<double> window;
@@ -831,8 +835,6 @@ int main(int argc, char** argv) {
   app.add_option("--max-steps", so.max_steps,
                  "Stop after this many steps in all (a checkpoint is written; --restart continues)")
       ->check(CLI::Range(1LL, 1000000000000LL));
-  app.add_flag("--check", so.check,
-               "Only check the scene and the options (exit 0, or 2 with the error); write and run nothing");
   app.add_option(
          "--batch", so.batch,
          "Run the members listed in this file as one batch (one model, one launch per kernel for all; "
@@ -840,6 +842,7 @@ int main(int argc, char** argv) {
          "member's folder gets what its run alone writes, with the same numbers")
       ->check(CLI::ExistingFile);
   return dcm::run_app(app, argc, argv, [&] {
+    so.check = options.check;
     if (window.size() == 2) {
       so.early_from_s = window[0];
       so.early_to_s = window[1];

@@ -41,6 +41,7 @@ void run(const AppOptions& options, const StretchOptions& so) {
   for (double f : so.forces_pN)
     if (!(f >= 0 && f <= 1e4))
       throw SceneError("--forces-pN: " + std::to_string(f) + " is out of range: allowed 0 .. 10000");
+  if (stop_after_check("stretch", options, scene)) return;
   const std::string out = prepare_output_dir(options, scene);
   KokkosSession kokkos(options.threads);
   const auto wall0 = std::chrono::steady_clock::now();
@@ -138,7 +139,9 @@ int main(int argc, char** argv) {
       "stretch");
   dcm::AppOptions options;
   dcm::StretchOptions so;
-  dcm::add_common_options(app, options);
+  dcm::add_common_options(app, options,
+                          {"", "--set mesh.nodes=642 --forces-pN 0,50,100,200 --out out/stretch642",
+                           "scenes/stretch.toml --pulled-fraction 0.05"});
   app.add_flag("--no-plot", so.no_plot, "Do not draw stretch.png");
   app.add_option(
          "--pulled-fraction", so.pulled_fraction,
