@@ -10,6 +10,8 @@
 #include <type_traits>
 #include <vector>
 
+#include "core/kokkos_compat.hpp"
+
 namespace dcm {
 
 // What kernels capture: the rows on the device, and whether any row is non-zero (for host-side decisions).
@@ -24,7 +26,7 @@ template <class T, class MemorySpace>
 struct PerCell {
   Kokkos::View<T*, Kokkos::LayoutRight, MemorySpace> values;
   std::vector<T> host;  // the same rows, for host-side decisions (is a term on anywhere?)
-  typename Kokkos::View<T*, Kokkos::LayoutRight, MemorySpace>::HostMirror mirror;  // staging for assign()
+  HostMirrorOf<Kokkos::View<T*, Kokkos::LayoutRight, MemorySpace>> mirror;  // staging for assign()
   PerCell() = default;
   explicit PerCell(const std::vector<T>& rows, const char* label = "dcm::per_cell")
       : values(Kokkos::view_alloc(Kokkos::WithoutInitializing, std::string(label)), rows.size()),

@@ -1,11 +1,18 @@
 #pragma once
 // The one place that knows Kokkos versions differ (3.4.1 is what CI sees; 4.x and 5.x must also work).
 //  - math: Kokkos::Experimental::sqrt & co. in 3.4-3.6, Kokkos::sqrt from 3.7 on;
-//  - initialisation: InitArguments (3.x) versus InitializationSettings (>= 3.7).
+//  - initialisation: InitArguments (3.x) versus InitializationSettings (>= 3.7);
+//  - a view's host mirror type: View::HostMirror, deprecated in 5.0 for View::host_mirror_type (which 3.4.1
+//    lacks); HostMirrorOf<V> below is the type create_mirror_view returns, in every version.
 // Everything else in dcm uses the subset of the API that all of them share.
 #include <Kokkos_Core.hpp>
+#include <utility>
 
 namespace dcm {
+
+template <class ViewType>
+using HostMirrorOf = decltype(Kokkos::create_mirror_view(std::declval<const ViewType&>()));
+
 namespace math {
 
 #if KOKKOS_VERSION >= 30700

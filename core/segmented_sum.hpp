@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include "core/kokkos_compat.hpp"
+
 namespace dcm {
 
 constexpr int kSumChunk = 64;
@@ -34,7 +36,7 @@ struct SumPlan {
   View<int*> segment_chunks;                  // first chunk of each segment (n_segments + 1)
   View<double* [kSumMaxComponents]> partial;  // chunk sums
   View<double* [kSumMaxComponents]> result;   // segment sums (scratch of segmented_total())
-  typename View<double* [kSumMaxComponents]>::HostMirror result_host;
+  HostMirrorOf<View<double* [kSumMaxComponents]>> result_host;
 
   SumPlan() = default;
   explicit SumPlan(const std::vector<int>& begin) {

@@ -9,6 +9,7 @@
 // the forces, the stiffness belongs to the positions of the last compute_forces().
 #include <vector>
 
+#include "core/kokkos_compat.hpp"
 #include "kernels/bending.hpp"
 
 namespace dcm {
@@ -18,7 +19,7 @@ struct BendingStiffness {
   Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> s;  // per hinge scratch: Δt k_b max(cos, 0) ∇θ · v
   // Δt k_b of the current step per cell (J·s)
   Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> dt_k_b;
-  typename Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace>::HostMirror dt_k_b_host;
+  HostMirrorOf<Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace>> dt_k_b_host;
   BendingStiffness() = default;
   explicit BendingStiffness(const MeshBuffers<MemorySpace>& mesh)
       : s("dcm::bending_stiffness::s", mesh.n_hinges),

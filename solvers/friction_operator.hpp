@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "core/buffers.hpp"
+#include "core/kokkos_compat.hpp"
 #include "core/vec3.hpp"
 #include "kernels/plane_contact.hpp"
 
@@ -61,7 +62,7 @@ struct FrictionOperator {
   // fills them from the scalars above, or from cell_rows when set (a batch of cells with different
   // constants: core/cell_params.hpp); Γ has no coupling between cells either way.
   View<double* [5]> cell_coef;
-  typename View<double* [5]>::HostMirror cell_coef_host;  // staging, kept (no allocation per step)
+  HostMirrorOf<View<double* [5]>> cell_coef_host;  // staging, kept (no allocation per step)
   std::vector<std::array<double, 5>> cell_rows;
 
   FrictionOperator() = default;

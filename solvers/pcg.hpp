@@ -14,6 +14,7 @@
 // alone, whatever shares the launch. One segment over all nodes (CgWorkspace(n)) is plain CG.
 #include <vector>
 
+#include "core/kokkos_compat.hpp"
 #include "core/segmented_sum.hpp"
 #include "core/vec3.hpp"
 
@@ -39,11 +40,11 @@ struct CgWorkspace {
   SumPlan<MemorySpace> sums;  // the dot products per segment: thread-count independent
   Kokkos::View<int*, Kokkos::LayoutRight, MemorySpace> node_segment;
   Scalars alpha, beta;  // per segment; 0 freezes a segment
-  typename Scalars::HostMirror alpha_host, beta_host;
+  HostMirrorOf<Scalars> alpha_host, beta_host;
   // 1 for the segments still iterating, kept up to date during a solve: an operator or preconditioner may
   // skip the rows of the others (their results are not used).
   Kokkos::View<int*, Kokkos::LayoutRight, MemorySpace> active;
-  typename Kokkos::View<int*, Kokkos::LayoutRight, MemorySpace>::HostMirror active_host;
+  HostMirrorOf<Kokkos::View<int*, Kokkos::LayoutRight, MemorySpace>> active_host;
   std::vector<CgResult> segment_results;  // of the last solve, one per segment
 
   CgWorkspace() = default;

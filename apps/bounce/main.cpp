@@ -253,7 +253,7 @@ class RigidBall {
   GeometryBuffers<Mem> geo_;
   ContactBuffers<Mem> contact_;
   Kokkos::View<double*[3], Kokkos::LayoutRight, Mem> body_, force_;
-  typename Kokkos::View<double* [3], Kokkos::LayoutRight, Mem>::HostMirror force_host_;
+  HostMirrorOf<Kokkos::View<double* [3], Kokkos::LayoutRight, Mem>> force_host_;
   std::vector<Real3> body_host_;
   double reach_ = 0;
 };
