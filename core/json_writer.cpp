@@ -77,6 +77,13 @@ JsonObject& JsonObject::add(const std::string& key, const std::vector<std::vecto
   return *this;
 }
 
+JsonObject& JsonObject::add(const std::string& key, const std::vector<std::string>& texts) {
+  std::string text = "[";
+  for (std::size_t i = 0; i < texts.size(); ++i) text += (i ? ", " : "") + json_string(texts[i]);
+  members_.emplace_back(key, text + "]");
+  return *this;
+}
+
 std::string JsonObject::str() const {
   std::string out = "{\n";
   for (std::size_t i = 0; i < members_.size(); ++i)

@@ -16,6 +16,7 @@ class JsonObject {
   JsonObject& add(const std::string& key, const char* value) { return add(key, std::string(value)); }
   JsonObject& add(const std::string& key, const std::vector<double>& values);
   JsonObject& add(const std::string& key, const std::vector<std::vector<double>>& rows);  // list of lists
+  JsonObject& add(const std::string& key, const std::vector<std::string>& texts);         // list of strings
   std::string str() const;
   // Writes to path via a temporary file and rename(), so a reader never sees half a file.
   void write(const std::string& path) const;

@@ -1,14 +1,16 @@
 #!/usr/bin/env python3
 """Plots of a spread run (apps/spread): r_cc.png, cells.png, side_views.png in the run's folder.
 
-    python3 scripts/plot_spread.py OUT_DIR
+    python3 scripts/plot_spread.py [--quiet] OUT_DIR
 
 r_cc.png    contact radius against time on log-log axes with a t^(1/2) guide and the fitted early slope
             (paper Figure 4 style)
 cells.png   the cell at the frames nearest t = 0.1, 0.35, 0.9 s, coloured by the normal force per node
-            (top) and the cortex tension of eq. 1 (bottom) (paper Figure 6 style)
+            (top) and the cortex tension of eq. 1 (bottom) (paper Figure 6 style); a run that ends before
+            0.9 s shows the frames nearest the same fractions of its own end time, each frame once
 side_views.png  side views (x-z) of the cell at the frames nearest t = 0, 0.1, 0.35, 0.9 s and the end
             (paper Figure 1 style)
+cells.png and side_views.png need the frames of spread.h5: a run with output.hdf5 = false gets r_cc.png only.
 """
 import csv
 import json
@@ -69,10 +71,22 @@ def plot_rcc(out, s, summary):
     plt.close(fig)
 
 
+def distinct(frame_list, times):
+    picks = []
+    for t in times:
+        f = nearest(frame_list, t)
+        if all(abs(f[0] - p[0]) > 1e-12 for p in picks):
+            picks.append(f)
+    return picks
+
+
 def plot_cells(out, h5, tri):
     fl = frames(h5)
-    picks = [nearest(fl, t) for t in (0.1, 0.35, 0.9)]
-    fig = plt.figure(figsize=(12, 7.5))
+    end = fl[-1][0]
+    times = (0.1, 0.35, 0.9) if end >= 0.9 else tuple(end * f / 0.9 for f in (0.1, 0.35, 0.9))
+    picks = distinct(fl, times)
+    ncol = len(picks)
+    fig = plt.figure(figsize=(4 * ncol, 7.5))
     for row, (field, label, cmap) in enumerate(
             [("normal_force_N", "normal force (pN)", "coolwarm"),
              ("cortex_tension_J_per_m2", "cortex tension (µN/m)", "viridis")]):
@@ -82,7 +96,7 @@ def plot_cells(out, h5, tri):
         vmin, vmax = (-lim, lim) if field == "normal_force_N" else (min(v.min() for v in vals), lim)
         for col, ((t, g), v) in enumerate(zip(picks, vals)):
             x = np.asarray(g["x"]) * 1e6
-            ax = fig.add_subplot(2, 3, 3 * row + col + 1, projection="3d")
+            ax = fig.add_subplot(2, ncol, ncol * row + col + 1, projection="3d")
             face = v[tri].mean(axis=1)
             surf = ax.plot_trisurf(x[:, 0], x[:, 1], x[:, 2], triangles=tri, cmap=cmap, linewidth=0,
                                    antialiased=False)
@@ -92,7 +106,7 @@ def plot_cells(out, h5, tri):
             ax.set_box_aspect((np.ptp(x[:, 0]), np.ptp(x[:, 1]), max(np.ptp(x[:, 2]), 1e-3)))
             ax.set_title(f"t = {t:.3f} s", fontsize=9)
             ax.set_axis_off()
-            if col == 2:
+            if col == ncol - 1:
                 fig.colorbar(surf, ax=ax, shrink=0.6, label=label)
     fig.tight_layout()
     fig.savefig(os.path.join(out, "cells.png"), dpi=110)
@@ -101,12 +115,7 @@ def plot_cells(out, h5, tri):
 
 def plot_side_views(out, h5):
     fl = frames(h5)
-    times = [0.0, 0.1, 0.35, 0.9, fl[-1][0]]
-    picks = []
-    for t in times:
-        f = nearest(fl, t)
-        if all(abs(f[0] - p[0]) > 1e-12 for p in picks):
-            picks.append(f)
+    picks = distinct(fl, [0.0, 0.1, 0.35, 0.9, fl[-1][0]])
     fig, axes = plt.subplots(1, len(picks), figsize=(3.0 * len(picks), 3.0), sharey=True)
     axes = np.atleast_1d(axes)
     for ax, (t, g) in zip(axes, picks):
@@ -124,18 +133,26 @@ def plot_side_views(out, h5):
 
 
 def main():
-    if len(sys.argv) != 2:
-        sys.exit("usage: plot_spread.py OUT_DIR")
-    out = sys.argv[1]
+    args = sys.argv[1:]
+    quiet = "--quiet" in args
+    args = [a for a in args if a != "--quiet"]
+    if len(args) != 1 or args[0].startswith("-"):
+        sys.exit("usage: plot_spread.py [--quiet] OUT_DIR")
+    out = args[0]
     s = read_series(os.path.join(out, "series.csv"))
     with open(os.path.join(out, "summary.json")) as f:
         summary = json.load(f)
     plot_rcc(out, s, summary)
-    with h5py.File(os.path.join(out, "spread.h5"), "r") as h5:
-        tri = np.asarray(h5["mesh"]["triangles"])
-        plot_cells(out, h5, tri)
-        plot_side_views(out, h5)
-    print(f"wrote {out}/r_cc.png, {out}/cells.png, {out}/side_views.png")
+    wrote = [f"{out}/r_cc.png"]
+    h5_path = os.path.join(out, "spread.h5")
+    if os.path.exists(h5_path):
+        with h5py.File(h5_path, "r") as h5:
+            tri = np.asarray(h5["mesh"]["triangles"])
+            plot_cells(out, h5, tri)
+            plot_side_views(out, h5)
+        wrote += [f"{out}/cells.png", f"{out}/side_views.png"]
+    if not quiet:
+        print("wrote " + ", ".join(wrote))
 
 
 if __name__ == "__main__":

@@ -157,12 +157,13 @@ def collect(scan, out, spread_ok):
             with open(os.path.join(mdir, "summary.json")) as f:
                 s = json.load(f)
             row.update({k: ("" if s.get(k) is None else s[k]) for k in SUMMARY_KEYS})  # null: not measured
+            row["warnings"] = len(s.get("warnings", []))  # spread's end-of-run warnings (unresolved steps)
         except (OSError, ValueError):
-            row.update({k: "" for k in SUMMARY_KEYS})
+            row.update({k: "" for k in SUMMARY_KEYS + ["warnings"]})
         rows.append(row)
     tmp = os.path.join(out, "summary.csv.part")
     with open(tmp, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=["id", "status"] + scan["sweep_keys"] + SUMMARY_KEYS)
+        w = csv.DictWriter(f, fieldnames=["id", "status"] + scan["sweep_keys"] + SUMMARY_KEYS + ["warnings"])
         w.writeheader()
         w.writerows(rows)
     os.replace(tmp, os.path.join(out, "summary.csv"))
@@ -187,7 +188,7 @@ def write_h5(scan, out, rows):
             mg.attrs["sets"] = json.dumps(m["sets"])
             for k, v in m["swept"].items():
                 mg.attrs["param:" + k] = v
-            for k in SUMMARY_KEYS:
+            for k in SUMMARY_KEYS + ["warnings"]:
                 if row.get(k, "") != "":
                     mg.attrs[k] = row[k]
             src_path = os.path.join(out, "members", m["id"], "spread.h5")
@@ -488,6 +489,11 @@ def main():
             plot(scan, out)
         if not a.quiet:
             print(f"{PROG}: wrote {out}/summary.csv, {out}/scan.h5 ({time.time() - t0:.1f} s)", flush=True)
+        warned = [r["id"] for r in rows if r.get("warnings") not in ("", 0)]
+        if warned:
+            print(f"{PROG}: warning: {len(warned)} member(s) ended with warnings (their steps did not resolve the "
+                  f"run; summary.csv column warnings, members/<id>/summary.json): {' '.join(warned[:10])}"
+                  f"{' ...' if len(warned) > 10 else ''}", file=sys.stderr)
         if stop:
             print(f"{PROG}: stopped; run the same command again to finish the missing members", file=sys.stderr)
             rc = 130

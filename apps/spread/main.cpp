@@ -5,10 +5,12 @@
 //   series.csv   t_s,r_cc_m,contact_area_m2,area_m2,volume_m3,cg_iterations,dt_s,height_m,contact_load_N,
 //                elastic_energy_J,dE_dt_W,contact_power_W,dissipation_W,energy_residual_W
 //                (log-spaced in time: output.series_per_decade rows per decade, and every step at the start)
-//   spread.h5/.xmf  mesh, series, frames (every output.frame_every_s and at t = 0.1, 0.35, 0.9 s) with the
-//                per-node normal force and pressure, cortex tension (eq. 1) and stretch
+//   spread.h5/.xmf  mesh, series (every column of series.csv), frames (every output.frame_every_s and at
+//                t = 0.1, 0.35, 0.9 s) with the per-node normal force and pressure, cortex tension (eq. 1) and
+//                stretch; not with output.hdf5 = false
 //   summary.json r_cc_final_m, contact_angle_deg, early_exponent (+ window), height_final_m, steps, wall_s,
-//                mean_cg_iterations, energy balance, ...
+//                mean_cg_iterations, energy balance, warnings (steps that did not resolve the run), ...
+// A new run removes an earlier run's files from its folder first (a restart continues them).
 //   r_cc.png, cells.png, side_views.png (scripts/plot_spread.py) unless --no-plot
 //   checkpoint.h5 the state at the end, on Ctrl-C and every output.checkpoint_every_s of wall time;
 //                `spread --restart <out>/checkpoint.h5` continues bit for bit (docs/CHECKPOINTS.md)
@@ -66,6 +68,47 @@ struct SpreadOptions {
   bool check = false;       // validate the scene and options, write nothing, run nothing
   std::string batch;        // file with one member per line: run them as one batch
 };
+
+// The columns of series.csv and of spread.h5's /series, one row per sample.
+const std::vector<std::string> kSeriesColumns = {"t_s",
+                                                 "r_cc_m",
+                                                 "contact_area_m2",
+                                                 "area_m2",
+                                                 "volume_m3",
+                                                 "cg_iterations",
+                                                 "dt_s",
+                                                 "height_m",
+                                                 "contact_load_N",
+                                                 "elastic_energy_J",
+                                                 "dE_dt_W",
+                                                 "contact_power_W",
+                                                 "dissipation_W",
+                                                 "energy_residual_W"};
+
+std::string series_header() {
+  std::string h;
+  for (const std::string& c : kSeriesColumns) h += (h.empty() ? "" : ",") + c;
+  return h + "\n";
+}
+
+// The rows of a series.csv text (header first), as kSeriesColumns values each: the HDF5 series of a
+// checkpoint written before app.series_rows existed.
+std::vector<double> parse_series_rows(const std::string& csv_text) {
+  std::vector<double> rows;
+  std::size_t pos = csv_text.find('\n');
+  while (pos != std::string::npos && pos + 1 < csv_text.size()) {
+    const std::size_t end = csv_text.find('\n', pos + 1);
+    const std::string line = csv_text.substr(pos + 1, end == std::string::npos ? end : end - pos - 1);
+    const char* c = line.c_str();
+    for (std::size_t k = 0; k < kSeriesColumns.size(); ++k) {
+      char* next = nullptr;
+      rows.push_back(std::strtod(c, &next));
+      c = *next == ',' ? next + 1 : next;
+    }
+    pos = end;
+  }
+  return rows;
+}
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -145,6 +188,11 @@ Scene spread_scene(const AppOptions& options, const SpreadOptions& so, const Che
     scene.set(set);
   }
   scene.validate();
+  const double t_done = restart->scalar("stepper.t");
+  if (!(scene.get_real("time.t_end_s") > t_done))
+    throw SceneError("time.t_end_s = " + detail::format_real(scene.get_real("time.t_end_s")) +
+                     " is not allowed with --restart " + so.restart + ": the checkpoint is at t = " +
+                     detail::format_real(t_done) + " s; continue with --set time.t_end_s=<a later time>");
   return scene;
 }
 
@@ -174,13 +222,13 @@ struct Member {
   std::string out_dir, checkpoint_path, csv_tmp;
   int cell = 0, first_node = 0, n = 0;
   Progress p;
-  std::vector<double> ts, rs, areas_c, heights;  // the series rows (HDF5 /series)
-  std::string csv_text =
-      "t_s,r_cc_m,contact_area_m2,area_m2,volume_m3,cg_iterations,dt_s,height_m,contact_load_N,"
-      "elastic_energy_J,dE_dt_W,contact_power_W,dissipation_W,energy_residual_W\n";
+  std::vector<double> ts, rs, areas_c, heights;  // series columns the summary's fits use
+  std::vector<double> series_rows;               // every series row (kSeriesColumns values each), for HDF5
+  std::string csv_text = series_header();
   int frames_before = 0;
   std::ofstream csv;
-  std::unique_ptr<H5Output> h5;
+  std::unique_ptr<H5Output> h5;   // spread.h5; null with output.hdf5 = false
+  bool wrote_checkpoint = false;  // this run (or the one it continues) has a checkpoint
   bool last = false, interrupted = false, stopped_at_max_steps = false, done = false;
   long long steps_before = 0;
   std::chrono::steady_clock::time_point last_checkpoint;
@@ -288,7 +336,16 @@ FrameData frame_data(Model& model, NodeFields<Exec::memory_space>& fields) {
           to_host_vector(fields.normal_force), to_host_vector(fields.normal_pressure)};
 }
 
+// One series row into spread.h5's /series (nothing with output.hdf5 = false).
+void append_h5_series(Member& m, const double* row) {
+  if (!m.h5) return;
+  std::vector<std::pair<std::string, double>> named;
+  for (std::size_t k = 0; k < kSeriesColumns.size(); ++k) named.emplace_back(kSeriesColumns[k], row[k]);
+  m.h5->append_series(named);
+}
+
 void write_frame(Member& m, const FrameData& d, double t) {
+  if (!m.h5) return;
   const auto slice = [&](const std::vector<double>& all, int per_node) {
     return std::vector<double>(all.begin() + per_node * m.first_node,
                                all.begin() + per_node * (m.first_node + m.n));
@@ -318,9 +375,11 @@ void write_checkpoint_now(Member& m, const Model& model, const Stepper& stepper,
   c.put("app.contact_area_m2", m.areas_c);
   c.put("app.height_m", m.heights);
   c.put_text("app.series_csv", m.csv_text);
-  c.put("app.frames", static_cast<double>(m.h5->frames()));
-  m.h5->flush();
+  c.put("app.series_rows", m.series_rows);
+  c.put("app.frames", m.h5 ? static_cast<double>(m.h5->frames()) : 0.0);
+  if (m.h5) m.h5->flush();
   write_checkpoint(m.checkpoint_path, c);
+  m.wrote_checkpoint = true;
 }
 
 // Numerical trouble ends the run (exit 3) with every member's files closed: what was done stays readable, no
@@ -328,15 +387,14 @@ void write_checkpoint_now(Member& m, const Model& model, const Stepper& stepper,
 [[noreturn]] void stop_on_numerical_trouble(std::vector<Member>& ms, const std::string& what) {
   for (Member& m : ms) {
     if (m.done) continue;
-    m.h5->close();
+    if (m.h5) m.h5->close();
     m.csv.close();
     std::rename(m.csv_tmp.c_str(), (m.out_dir + "/series.csv").c_str());
   }
   const Member& m = ms.front();
   throw NumericalError(what + " — try a smaller time.dt_s or time.adaptive = true" +
-                       (ms.size() == 1 && std::filesystem::exists(m.checkpoint_path)
-                            ? "; the last checkpoint is " + m.checkpoint_path
-                            : std::string()));
+                       (ms.size() == 1 && m.wrote_checkpoint ? "; the last checkpoint is " + m.checkpoint_path
+                                                             : std::string()));
 }
 
 // The end of a member's run: checkpoint, final frame, files closed, summary and plots.
@@ -348,7 +406,7 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   write_frame(m, frame_data(model, fields), t);
   m.csv.close();
   std::rename(m.csv_tmp.c_str(), (m.out_dir + "/series.csv").c_str());
-  m.h5->close();
+  if (m.h5) m.h5->close();
   m.done = true;
 
   const long long done = static_cast<long long>(m.p.step);
@@ -361,6 +419,33 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   const double alpha = fit_exponent(m.ts, m.rs, so.early_from_s, so.early_to_s, used);
   const double wall = m.p.wall_before + wall_now;
   const Progress& p = m.p;
+  // A run that ends but did not resolve its dynamics says so (stderr, also with --quiet, and summary.json's
+  // "warnings"): energy bookkeeping off by more than half of the powers (unless adaptive steps at their cap
+  // explain it: the note below), or more step halvings than steps (healthy runs: below 0.25 and none;
+  // docs/model/spread.md, "Energy balance").
+  const double residual_rel = p.worst_residual_scale > 0 ? p.worst_residual / p.worst_residual_scale : 0.0;
+  std::vector<std::string> warnings;
+  char text[320];
+  const bool long_adaptive_steps = stepper.settings().adaptive && p.h_max >= 0.99 * stepper.settings().dt_max;
+  if (residual_rel > 0.5 && !long_adaptive_steps) {  // with long adaptive steps: the note below
+    std::snprintf(
+        text, sizeof text,
+        "the energy balance is off by %.2g of the powers (energy_residual_relative): the steps do not "
+        "resolve this run; use a smaller time.dt_s or time.adaptive = true",
+        residual_rel);
+    warnings.emplace_back(text);
+  }
+  if (p.halved > static_cast<double>(done) && done > 0) {
+    std::snprintf(
+        text, sizeof text,
+        "%.0f step halvings in %lld steps (bonds near d_max): time.dt_s is too long for this scene; "
+        "use a smaller one or time.adaptive = true",
+        p.halved, done);
+    warnings.emplace_back(text);
+  }
+  for (const std::string& w : warnings)
+    std::fprintf(stderr, "spread: warning: %s%s\n",
+                 m.cell > 0 || !m.so.batch.empty() ? (m.out_dir + ": ").c_str() : "", w.c_str());
   JsonObject summary;
   summary.add("scene", m.scene.name())
       .add("nodes", m.n)
@@ -388,9 +473,9 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
       .add("mean_cg_iterations", done > 0 ? p.cg_total / done : 0.0)
       .add("max_cg_iterations", static_cast<long long>(p.cg_max))
       .add("energy_residual_max_W", p.worst_residual)
-      .add("energy_residual_relative",
-           p.worst_residual_scale > 0 ? p.worst_residual / p.worst_residual_scale : 0.0)
-      .add("checkpoint", m.checkpoint_path);
+      .add("energy_residual_relative", residual_rel)
+      .add("checkpoint", m.checkpoint_path)
+      .add("warnings", warnings);
   summary.write(m.out_dir + "/summary.json");
   if (!m.options.quiet) {
     // No exponent (null in summary.json) when fewer than three series rows with contact lie in the window.
@@ -410,19 +495,29 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   }
   // Adaptive steps control the position error, not the energy bookkeeping: say when the longest steps left
   // the energy balance unresolved (docs/model/spread.md, "Energy balance").
-  const double residual_relative =
-      p.worst_residual_scale > 0 ? p.worst_residual / p.worst_residual_scale : 0.0;
   const double dt_max = stepper.settings().dt_max;
-  if (!m.options.quiet && stepper.settings().adaptive && residual_relative > 0.01 && p.h_max >= 0.99 * dt_max)
+  if (!m.options.quiet && long_adaptive_steps && residual_rel > 0.01)
     std::printf(
         "  note: the energy residual is %.2g of the powers with steps up to time.dt_max_s = %g s; r_cc is "
         "controlled by time.error_tol_m, the energy balance is not resolved at these steps: lower "
         "time.dt_max_s to resolve it\n",
-        residual_relative, dt_max);
+        residual_rel, dt_max);
   if (so.plot && !m.interrupted && !m.stopped_at_max_steps) {
-    const std::string cmd =
-        std::string(DCM_PYTHON3) + " '" + DCM_SOURCE_DIR + "/scripts/plot_spread.py' '" + m.out_dir + "'";
+    const std::string cmd = std::string(DCM_PYTHON3) + " '" + DCM_SOURCE_DIR + "/scripts/plot_spread.py' " +
+                            (m.options.quiet ? "--quiet '" : "'") + m.out_dir + "'";
+    std::fflush(stdout);  // this run's lines before the plotter's
     if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "spread: plotting failed (%s)\n", cmd.c_str());
+  }
+}
+
+// A new run in a folder that held an earlier one: that run's files go first, so that none of them (a
+// summary, a checkpoint, plots of other data) is left beside a run that stops early.
+void remove_earlier_outputs(const std::string& dir) {
+  for (const char* name : {"summary.json", "series.csv", "series.csv.part", "spread.h5", "spread.xmf",
+                           "checkpoint.h5", "checkpoint.h5.tmp", "r_cc.png", "cells.png", "side_views.png"}) {
+    std::error_code ec;
+    std::filesystem::remove(std::filesystem::path(dir) / name, ec);
+    if (ec) throw IoError(dir + "/" + name + ": cannot remove the earlier run's file (" + ec.message() + ")");
   }
 }
 
@@ -449,6 +544,8 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
                           : prepare_output_dir(m.options, m.scene);
     if (m.out_dir.empty()) m.out_dir = ".";
     m.checkpoint_path = m.out_dir + "/checkpoint.h5";
+    m.wrote_checkpoint = m.restart.has_value();
+    if (!m.restart) remove_earlier_outputs(m.out_dir);
     m.csv_tmp = m.out_dir + "/series.csv.part";
   }
   KokkosSession kokkos(threads);
@@ -488,11 +585,15 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
       m.areas_c = c.array("app.contact_area_m2", m.ts.size());
       m.heights = c.array("app.height_m", m.ts.size());
       m.csv_text = c.text("app.series_csv");
+      m.series_rows =
+          c.arrays.count("app.series_rows") ? c.array("app.series_rows") : parse_series_rows(m.csv_text);
       m.frames_before = static_cast<int>(c.scalar("app.frames"));
     }
     std::vector<int> tri, node_cell(m.n, 0);
     for (const Tri& t : m.mesh.triangles) tri.insert(tri.end(), t.begin(), t.end());
-    if (m.restart) {
+    if (!m.scene.get_bool("output.hdf5")) {
+      m.h5.reset();
+    } else if (m.restart) {
       m.h5 = std::make_unique<H5Output>(m.out_dir + "/spread.h5", H5Output::Resume{m.frames_before});
     } else {
       m.h5 = std::make_unique<H5Output>(m.out_dir + "/spread.h5");
@@ -500,11 +601,8 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
       m.h5->write_mesh(model.cell_slice(model.positions(), m.cell).data(), m.n, tri.data(),
                        static_cast<int>(m.mesh.triangles.size()), node_cell.data());
     }
-    for (std::size_t i = 0; i < m.ts.size(); ++i)
-      m.h5->append_series({{"t_s", m.ts[i]},
-                           {"r_cc_m", m.rs[i]},
-                           {"contact_area_m2", m.areas_c[i]},
-                           {"height_m", m.heights[i]}});
+    for (std::size_t i = 0; i + kSeriesColumns.size() <= m.series_rows.size(); i += kSeriesColumns.size())
+      append_h5_series(m, &m.series_rows[i]);
     m.csv.open(m.csv_tmp, std::ios::trunc);
     m.csv << m.csv_text;
     if (!m.csv) throw IoError(m.csv_tmp + ": cannot write");
@@ -518,9 +616,14 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
           m.so.restart.c_str(), stepper.time(m.cell), static_cast<long long>(m.p.step),
           m.scene.name().c_str(), m.n, m.t_end, kokkos_description().c_str());
     else if (ms.size() == 1)
-      std::printf("dcm spread: scene '%s', %d nodes, dt = %.3g s, t_end = %.3g s (%lld steps); %s\n",
-                  m.scene.name().c_str(), m.n, m.dt, m.t_end, std::llround(m.t_end / m.dt),
-                  kokkos_description().c_str());
+      std::printf(
+          "dcm spread: scene '%s', %d nodes, %s, t_end = %.3g s; %s\n", m.scene.name().c_str(), m.n,
+          m.steps.adaptive
+              ? ("adaptive steps from dt = " + detail::format_real(m.dt) + " s").c_str()
+              : ("dt = " + detail::format_real(m.dt) + " s (" +
+                 std::to_string(static_cast<long long>(std::ceil(m.t_end / m.dt * (1 - 1e-12)))) + " steps)")
+                    .c_str(),
+          m.t_end, kokkos_description().c_str());
   }
   if (!quiet && ms.size() > 1)
     std::printf("dcm spread: a batch of %zu members (%d nodes each) in one model; %s\n", ms.size(), ms[0].n,
@@ -631,19 +734,34 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
         const double r_cc = std::sqrt(area_c / kPi);
         double ztop = -INFINITY;
         for (int i = m.first_node; i < m.first_node + m.n; ++i) ztop = std::max(ztop, x_all[3 * i + 2]);
+        const double row[] = {t + h,
+                              r_cc,
+                              area_c,
+                              cell_area[m.cell],
+                              cell_volume[m.cell],
+                              static_cast<double>(r.iterations),
+                              h,
+                              ztop - m.plane_z,
+                              load_cells[m.cell],
+                              e_after,
+                              de,
+                              m.pc,
+                              m.dis,
+                              residual};
+        static_assert(sizeof row / sizeof row[0] == 14, "one value per series column");
         char line[512];
         std::snprintf(line, sizeof line,
-                      "%.9g,%.9g,%.9g,%.9g,%.9g,%d,%.6g,%.9g,%.9g,%.12g,%.6g,%.6g,%.6g,%.6g\n", t + h, r_cc,
-                      area_c, cell_area[m.cell], cell_volume[m.cell], r.iterations, h, ztop - m.plane_z,
-                      load_cells[m.cell], e_after, de, m.pc, m.dis, residual);
+                      "%.9g,%.9g,%.9g,%.9g,%.9g,%d,%.6g,%.9g,%.9g,%.12g,%.6g,%.6g,%.6g,%.6g\n", row[0],
+                      row[1], row[2], row[3], row[4], r.iterations, row[6], row[7], row[8], row[9], row[10],
+                      row[11], row[12], row[13]);
         m.csv << line;
         m.csv_text += line;
         m.ts.push_back(t + h);
         m.rs.push_back(r_cc);
         m.areas_c.push_back(area_c);
         m.heights.push_back(ztop - m.plane_z);
-        m.h5->append_series(
-            {{"t_s", t + h}, {"r_cc_m", r_cc}, {"contact_area_m2", area_c}, {"height_m", ztop - m.plane_z}});
+        m.series_rows.insert(m.series_rows.end(), row, row + kSeriesColumns.size());
+        append_h5_series(m, row);
         p.next_sample = (t + h) * std::pow(10.0, 1.0 / m.per_decade);
       }
       m.stopped_at_max_steps = m.so.max_steps > 0 && p.step >= static_cast<double>(m.so.max_steps) && !m.last;

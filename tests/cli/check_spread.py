@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Checks a spread run's output: check_spread.py OUT_DIR [--interrupted]
 
-series.csv has the required columns and finite rows, r_cc grows, summary.json has the required keys, the
-energy balance residual is small against the powers, the HDF5 file opens and holds frames with the node
-fields. With --interrupted: the summary says so and the files are still valid."""
+series.csv has the required columns and finite rows, r_cc grows, summary.json has the required keys and no
+warnings, the energy balance residual is small against the powers, the HDF5 file opens and holds frames with
+the node fields and a /series with every column and row of series.csv. With --interrupted: the summary says so
+and the files are still valid."""
 import csv
 import json
 import math
@@ -49,6 +50,8 @@ def main():
         fail(f"summary.json interrupted = {s.get('interrupted')}, expected {interrupted}")
     if not interrupted and not s["energy_residual_relative"] < 0.05:
         fail(f"energy residual {s['energy_residual_relative']} of the powers")
+    if s.get("warnings") != []:
+        fail(f"summary.json warnings = {s.get('warnings')}, expected none")
     with h5py.File(os.path.join(out, "spread.h5"), "r") as h5:
         frames = list(h5["frames"].keys())
         if not frames:
@@ -56,6 +59,14 @@ def main():
         for name in FIELDS:
             if name not in h5["frames"][frames[-1]]:
                 fail(f"frame {frames[-1]} has no field {name}")
+        for c in reader.fieldnames:
+            if c not in h5["series"]:
+                fail(f"spread.h5 /series has no column {c}")
+            col = h5["series"][c][:]
+            if len(col) != len(rows):
+                fail(f"spread.h5 /series/{c} has {len(col)} rows, series.csv {len(rows)}")
+            if not all(math.isclose(float(r[c]), float(v), rel_tol=1e-5, abs_tol=1e-30) for r, v in zip(rows, col)):
+                fail(f"spread.h5 /series/{c} differs from series.csv")
     print(f"check_spread: {out}: {len(rows)} rows, {len(frames)} frames, r_cc {float(rows[-1]['r_cc_m']):.3g} m")
 
 
