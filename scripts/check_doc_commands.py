@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Every command line the docs show must still be accepted: each `build/bin/APP ...` in README.md and
-docs/**/*.md, and each line under "Examples:" in an app's --help, names an existing app, each --flag it uses is one the app's --help lists, and each --set KEY is
+docs/**/*.md, and each line under "Examples:" in an app's --help (which, where the app has --check, must
+also pass it), names an existing app, each --flag it uses is one the app's --help lists, and each --set KEY is
 a scene key (spread --list-keys) whose documented value `spread --check` accepts, and each scenes/*.toml it
 names exists.
 Usage: check_doc_commands.py SOURCE_DIR BIN_DIR [DOC.md ...]   (default: README.md and docs/**/*.md)
@@ -85,7 +86,14 @@ if not sys.argv[3:]:
             if not line.startswith("  ") or not words or words[0] != exe.name:
                 break
             checked += 1
-            check_command(exe.name, words[1] if len(words) > 1 else "", f"{exe.name} --help")
+            args = words[1] if len(words) > 1 else ""
+            check_command(exe.name, args, f"{exe.name} --help")
+            # An app with --check must accept its own example as it stands (a restart needs its checkpoint).
+            if re.search(r"--check(?![a-z-])", h) and "--restart" not in args:
+                r = subprocess.run([str(exe)] + args.split() + ["--check", "--quiet"], capture_output=True,
+                                   text=True, timeout=60, cwd=src)
+                if r.returncode != 0:
+                    problems.append(f"{exe.name} --help: example `{line.strip()}`: {(r.stderr or r.stdout).strip()}")
 
 # The values: each documented KEY=VALUE (placeholders such as N or <run> left out) must pass spread --check.
 for (key, value), where in sorted(pairs.items()):

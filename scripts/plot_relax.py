@@ -62,7 +62,7 @@ def main():
     fig.tight_layout()
     out = os.path.join(args.out_dir, "relax.png")
     fig.savefig(out, dpi=120)
-    print(out)
+    print(f"  wrote {out}")
     return 0
 
 

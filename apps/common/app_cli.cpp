@@ -68,6 +68,14 @@ std::string prepare_output_dir(const AppOptions& o, const Scene& scene) {
   return dir;
 }
 
+void remove_earlier_outputs(const std::string& dir, std::initializer_list<const char*> names) {
+  for (const char* name : names) {
+    std::error_code ec;
+    std::filesystem::remove(std::filesystem::path(dir) / name, ec);
+    if (ec) throw IoError(dir + "/" + name + ": cannot remove the earlier run's file (" + ec.message() + ")");
+  }
+}
+
 int run_app(CLI::App& app, int argc, char** argv, const std::function<void()>& body) {
   const std::string name = app.get_name();
   try {

@@ -7,6 +7,7 @@
 //   1  anything else (a bug: please report it).
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <initializer_list>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -44,6 +45,11 @@ Scene load_scene(const AppOptions& options, const std::vector<std::string>& with
 
 // --out, else output.dir, else out/<scene name>. Creates it; throws IoError if it cannot be written.
 std::string prepare_output_dir(const AppOptions& options, const Scene& scene);
+
+// A new run in a folder that held an earlier one: the files of that run (`names`, the app's outputs) go
+// first, so that none of them (a summary, a checkpoint, plots of other data) is left beside a run that stops
+// early. Throws IoError if one cannot be removed.
+void remove_earlier_outputs(const std::string& dir, std::initializer_list<const char*> names);
 
 // Parses the command line and runs body with the failure policy above. Returns the exit code.
 int run_app(CLI::App& app, int argc, char** argv, const std::function<void()>& body);

@@ -49,10 +49,11 @@ void run(const Options& o) {
     throw dcm::SceneError("--nodes = " + std::to_string(o.nodes) +
                           " is not allowed: choose 162, 642, 2562 or 10242 (icosphere node counts)");
   if (!(o.volume_fraction >= 0.3 && o.volume_fraction <= 1))
-    throw dcm::SceneError("--volume-fraction = " + std::to_string(o.volume_fraction) +
+    throw dcm::SceneError("--volume-fraction = " + dcm::detail::format_real(o.volume_fraction) +
                           " is out of range: allowed 0.3 .. 1");
   if (!(o.squash >= 0.1 && o.squash <= 1))
-    throw dcm::SceneError("--squash = " + std::to_string(o.squash) + " is out of range: allowed 0.1 .. 1");
+    throw dcm::SceneError("--squash = " + dcm::detail::format_real(o.squash) +
+                          " is out of range: allowed 0.1 .. 1");
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
   if (ec || !std::filesystem::is_directory(o.out))

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -57,13 +58,15 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
   // Without a scene file: the paper's experiment, a 2562-node Evans-Fung cell with Table 1 constants.
   const Scene scene = load_scene(options, {"name=relax", "mesh.shape=evans_fung"});
   if (!(ro.hold_force_pN > 0 && ro.hold_force_pN <= 1e4))
-    throw SceneError("--hold-force-pN = " + std::to_string(ro.hold_force_pN) +
+    throw SceneError("--hold-force-pN = " + detail::format_real(ro.hold_force_pN) +
                      " is out of range: allowed > 0 .. 10000");
   if (!(ro.duration_s > 0 && ro.duration_s <= 100))
-    throw SceneError("--duration-s = " + std::to_string(ro.duration_s) +
+    throw SceneError("--duration-s = " + detail::format_real(ro.duration_s) +
                      " is out of range: allowed > 0 .. 100");
   if (stop_after_check("relax", options, scene)) return;
   const std::string out = prepare_output_dir(options, scene);
+  remove_earlier_outputs(
+      out, {"series.csv", "series.csv.tmp", "summary.json", "relax.h5", "relax.xmf", "relax.png"});
   KokkosSession kokkos(options.threads);
   const auto wall0 = std::chrono::steady_clock::now();
 
@@ -97,10 +100,13 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
   const CgSettings cg = cg_settings_from_scene(scene);
   std::vector<int> tri, node_cell(n, 0);
   for (const Tri& t : mesh.triangles) tri.insert(tri.end(), t.begin(), t.end());
-  H5Output h5(out + "/relax.h5");
-  h5.write_text("scene", scene.to_toml());
-  h5.write_mesh(to_host_vector(model.positions()).data(), n, tri.data(),
-                static_cast<int>(mesh.triangles.size()), node_cell.data());
+  std::unique_ptr<H5Output> h5;  // none with output.hdf5 = false
+  if (scene.get_bool("output.hdf5")) {
+    h5 = std::make_unique<H5Output>(out + "/relax.h5");
+    h5->write_text("scene", scene.to_toml());
+    h5->write_mesh(to_host_vector(model.positions()).data(), n, tri.data(),
+                   static_cast<int>(mesh.triangles.size()), node_cell.data());
+  }
   std::ofstream csv(out + "/series.csv.tmp");
   csv << "t_s,DA_m,DT_m,energy_J,dissipation_W,cg_iterations\n";
   std::vector<double> ts, ys;
@@ -131,7 +137,7 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
       ts.push_back(t);
       ys.push_back((da / dtr - lambda_inf) / (da / dtr + lambda_inf));
       if (step % (ro.sample_every * 20) == 0) {
-        h5.write_frame(t, x.data(), {});
+        if (h5) h5->write_frame(t, x.data(), {});
         if (!options.quiet)
           std::printf("  t = %.4f s  D_A = %.3f um  D_T = %.3f um  CG %d it  (%.0f%%)\n", t, da * 1e6,
                       dtr * 1e6, r.iterations, 100.0 * step / steps);
@@ -142,7 +148,7 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
   }
   csv.close();
   std::rename((out + "/series.csv.tmp").c_str(), (out + "/series.csv").c_str());
-  h5.close();
+  if (h5) h5->close();
   const double tc = fit_relaxation_time(ts, ys, 0.05 * y0);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   JsonObject summary;
@@ -165,6 +171,7 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
   if (!ro.no_plot) {  // relax.png: D_A(t), D_T(t) and the fit
     const std::string cmd = std::string(DCM_PYTHON3) + " '" + DCM_SOURCE_DIR + "/scripts/plot_relax.py' '" +
                             out + "'" + (options.quiet ? " > /dev/null" : "");
+    std::fflush(stdout);  // this run's lines before the plotter's
     if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "relax: plotting failed (%s)\n", cmd.c_str());
   }
 }

@@ -6,8 +6,8 @@
 //                elastic_energy_J,dE_dt_W,contact_power_W,dissipation_W,energy_residual_W
 //                (log-spaced in time: output.series_per_decade rows per decade, and every step at the start)
 //   spread.h5/.xmf  mesh, series (every column of series.csv), frames (every output.frame_every_s and at
-//                t = 0.1, 0.35, 0.9 s) with the per-node normal force and pressure, cortex tension (eq. 1) and
-//                stretch; not with output.hdf5 = false
+//                t = 0.1, 0.35, 0.9 s) with the per-node normal force and pressure, cortex tension (eq. 1)
+//                and stretch; not with output.hdf5 = false
 //   summary.json r_cc_final_m, contact_angle_deg, early_exponent (+ window), height_final_m, steps, wall_s,
 //                mean_cg_iterations, energy balance, warnings (steps that did not resolve the run), ...
 // A new run removes an earlier run's files from its folder first (a restart continues them).
@@ -253,8 +253,8 @@ void prepare_member(Member& m) {
   if (!scene.get_bool("contact.plane"))
     throw SceneError("contact.plane = false: spread needs the substrate plane (set contact.plane = true)");
   if (!(so.early_from_s > 0 && so.early_to_s > so.early_from_s))
-    throw SceneError("--early-window-s = " + std::to_string(so.early_from_s) + "," +
-                     std::to_string(so.early_to_s) + " is not allowed: need 0 < from < to");
+    throw SceneError("--early-window-s = " + detail::format_real(so.early_from_s) + "," +
+                     detail::format_real(so.early_to_s) + " is not allowed: need 0 < from < to");
   const double h0 = scene.get_real("contact.h0_m"), gap = scene.get_real("contact.start_gap_m");
   const bool falls =
       scene.get_real("body.gravity_m_per_s2") > 0 && scene.get_real("body.density_excess_kg_per_m3") > 0;
@@ -510,17 +510,6 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   }
 }
 
-// A new run in a folder that held an earlier one: that run's files go first, so that none of them (a
-// summary, a checkpoint, plots of other data) is left beside a run that stops early.
-void remove_earlier_outputs(const std::string& dir) {
-  for (const char* name : {"summary.json", "series.csv", "series.csv.part", "spread.h5", "spread.xmf",
-                           "checkpoint.h5", "checkpoint.h5.tmp", "r_cc.png", "cells.png", "side_views.png"}) {
-    std::error_code ec;
-    std::filesystem::remove(std::filesystem::path(dir) / name, ec);
-    if (ec) throw IoError(dir + "/" + name + ": cannot remove the earlier run's file (" + ec.message() + ")");
-  }
-}
-
 // Runs the members as one batch (one member: the ordinary run). Forward Euler at the scene's fixed Δt (the
 // paper's) or with adaptive, error-controlled steps, each member with its own steps; a step that would take
 // a bond too close to d_max is taken again with half the step (solvers/time_stepper.hpp).
@@ -545,7 +534,10 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
     if (m.out_dir.empty()) m.out_dir = ".";
     m.checkpoint_path = m.out_dir + "/checkpoint.h5";
     m.wrote_checkpoint = m.restart.has_value();
-    if (!m.restart) remove_earlier_outputs(m.out_dir);
+    if (!m.restart)
+      remove_earlier_outputs(
+          m.out_dir, {"summary.json", "series.csv", "series.csv.part", "spread.h5", "spread.xmf",
+                      "checkpoint.h5", "checkpoint.h5.tmp", "r_cc.png", "cells.png", "side_views.png"});
     m.csv_tmp = m.out_dir + "/series.csv.part";
   }
   KokkosSession kokkos(threads);
@@ -937,7 +929,7 @@ int main(int argc, char** argv) {
   dcm::add_common_options(
       app, options,
       {"scenes/default.toml", "scenes/hategan2004_sphered.toml --out out/hategan",
-       "scenes/evans_fung.toml --set mesh.nodes=10242 --set time.t_end_s=0.5 --out out/ef10k",
+       "scenes/hategan2004_biconcave.toml --set mesh.nodes=642 --set time.adaptive=true --out out/bic642",
        "--restart out/hategan/checkpoint.h5 --set time.t_end_s=4"});
   app.add_flag(
       "--no-plot", [&](std::int64_t) { so.plot = false; }, "Do not write the PNG plots");

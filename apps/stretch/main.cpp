@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <numeric>
 #include <sstream>
 #include <string>
@@ -40,9 +41,11 @@ void run(const AppOptions& options, const StretchOptions& so) {
   const Scene scene = load_scene(options, {"name=stretch", "mesh.shape=evans_fung"});
   for (double f : so.forces_pN)
     if (!(f >= 0 && f <= 1e4))
-      throw SceneError("--forces-pN: " + std::to_string(f) + " is out of range: allowed 0 .. 10000");
+      throw SceneError("--forces-pN = " + detail::format_real(f) + " is out of range: allowed 0 .. 10000");
   if (stop_after_check("stretch", options, scene)) return;
   const std::string out = prepare_output_dir(options, scene);
+  remove_earlier_outputs(
+      out, {"series.csv", "series.csv.tmp", "summary.json", "stretch.h5", "stretch.xmf", "stretch.png"});
   KokkosSession kokkos(options.threads);
   const auto wall0 = std::chrono::steady_clock::now();
 
@@ -58,11 +61,12 @@ void run(const AppOptions& options, const StretchOptions& so) {
 
   std::vector<int> tri, node_cell(n, 0);
   for (const Tri& t : mesh.triangles) tri.insert(tri.end(), t.begin(), t.end());
-  H5Output h5(out + "/stretch.h5");
-  h5.write_text("scene", scene.to_toml());
-  {
+  std::unique_ptr<H5Output> h5;  // none with output.hdf5 = false
+  if (scene.get_bool("output.hdf5")) {
+    h5 = std::make_unique<H5Output>(out + "/stretch.h5");
+    h5->write_text("scene", scene.to_toml());
     const auto x0 = to_host_vector(model.positions());
-    h5.write_mesh(x0.data(), n, tri.data(), static_cast<int>(mesh.triangles.size()), node_cell.data());
+    h5->write_mesh(x0.data(), n, tri.data(), static_cast<int>(mesh.triangles.size()), node_cell.data());
   }
   std::ofstream csv(out + "/series.csv.tmp");
   csv << "F_N,DA_m,DT_m,newton_steps,max_residual_force_N\n";
@@ -80,23 +84,15 @@ void run(const AppOptions& options, const StretchOptions& so) {
     const NewtonResult r = newton_equilibrium(model, ns, edge);
     const auto x = to_host_vector(model.positions());
     const auto [d_axial, d_transverse] = axial_transverse_diameters(x);
-    forces.push_back(f);
-    da.push_back(d_axial);
-    dt.push_back(d_transverse);
-    char line[256];
-    std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%d,%.6g\n", f, da.back(), dt.back(), r.newton_steps,
-                  r.max_force);
-    csv << line;
-    const auto ext_h = to_host_vector(model.external_force());
-    h5.write_frame(f, x.data(), {{"external_force_N", 3, ext_h.data()}});
     if (!options.quiet)
       std::printf("  F = %7.2f pN   D_A = %6.3f um   D_T = %6.3f um   (%d Newton steps, residual %.2g N%s)\n",
-                  f_pN, da.back() * 1e6, dt.back() * 1e6, r.newton_steps, r.max_force,
+                  f_pN, d_axial * 1e6, d_transverse * 1e6, r.newton_steps, r.max_force,
                   r.converged ? "" : ", NOT CONVERGED");
     std::fflush(stdout);
     if (!r.converged) {
       csv.close();  // keep the forces that did converge
       std::rename((out + "/series.csv.tmp").c_str(), (out + "/series.csv").c_str());
+      if (h5) h5->close();
       char msg[256];
       std::snprintf(
           msg, sizeof msg,
@@ -105,10 +101,21 @@ void run(const AppOptions& options, const StretchOptions& so) {
           f_pN, r.newton_steps, r.max_force);
       throw NumericalError(msg);
     }
+    forces.push_back(f);
+    da.push_back(d_axial);
+    dt.push_back(d_transverse);
+    char line[256];
+    std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%d,%.6g\n", f, da.back(), dt.back(), r.newton_steps,
+                  r.max_force);
+    csv << line;
+    if (h5) {
+      const auto ext_h = to_host_vector(model.external_force());
+      h5->write_frame(f, x.data(), {{"external_force_N", 3, ext_h.data()}});
+    }
   }
   csv.close();
   std::rename((out + "/series.csv.tmp").c_str(), (out + "/series.csv").c_str());
-  h5.close();
+  if (h5) h5->close();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   JsonObject summary;
   summary.add("scene", scene.name())
@@ -120,10 +127,12 @@ void run(const AppOptions& options, const StretchOptions& so) {
       .add("wall_s", wall);
   summary.write(out + "/summary.json");
   if (!options.quiet)
-    std::printf("  wrote %s/series.csv, summary.json, stretch.h5 (%.1f s)\n", out.c_str(), wall);
+    std::printf("  wrote %s/series.csv, summary.json%s (%.1f s)\n", out.c_str(), h5 ? ", stretch.h5" : "",
+                wall);
   if (!so.no_plot) {  // stretch.png against Mills 2004 and Suresh 2005 (../shared/data/stretching)
     const std::string cmd = std::string(DCM_PYTHON3) + " '" + DCM_SOURCE_DIR + "/scripts/plot_stretch.py' '" +
                             out + "'" + (options.quiet ? " > /dev/null" : "");
+    std::fflush(stdout);  // this run's lines before the plotter's
     if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "stretch: plotting failed (%s)\n", cmd.c_str());
   }
 }
