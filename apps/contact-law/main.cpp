@@ -53,13 +53,25 @@ bool validate(const Options& o) {
   return ok;
 }
 
+// A CSV field: empty where the quantity is undefined (NaN), never "nan" or "-0".
+std::string field(double v) {
+  if (std::isnan(v)) return "";
+  char b[32];
+  std::snprintf(b, sizeof b, "%.10g", v + 0.0);
+  return b;
+}
+
 void print_row(const dcm::MdState& st, const Options& o, const dcm::MdMaterial& mat) {
   const double L = dcm::md_length_unit(mat, o.R);
   const double lambda = dcm::md_lambda(mat, o.R);
   const double force_unit = dcm::kMdPi * mat.W * o.R;
   const double m = st.a > 0 ? st.c / st.a : (st.c > 0 ? INFINITY : NAN);
-  std::printf("%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", st.a, st.delta, m, st.c, lambda,
-              L > 0 ? st.a / L : NAN, force_unit > 0 ? st.P / force_unit + 0.0 : NAN, st.P + 0.0);  // no -0
+  const double values[] = {
+      st.a, st.delta, m, st.c, lambda, L > 0 ? st.a / L : NAN, force_unit > 0 ? st.P / force_unit : NAN,
+      st.P};
+  std::string line;
+  for (const double v : values) line += (line.empty() ? "" : ",") + field(v);
+  std::printf("%s\n", line.c_str());
 }
 
 }  // namespace
@@ -72,7 +84,9 @@ int main(int argc, char** argv) {
       "a contact radius, delta geometric overlap (a^2 = 2 R delta - delta^2; negative: gap), m = c/a, c "
       "adhesive "
       "radius, lambda Maugis' parameter, Abar = a/(pi W R^2/K)^(1/3), Pbar = P/(pi W R), P net load "
-      "(repulsive > 0). In the gap branch a = 0 and m = inf (nan beyond h0, where c = 0).\n"
+      "(repulsive > 0). In the gap branch a = 0 and m = inf (empty beyond h0, where c = 0). With W = 0 "
+      "(Hertz) "
+      "Abar and Pbar are undefined: empty fields.\n"
       "Model and checks: docs/model/contact.md",
       "contact-law");
   app.footer(

@@ -62,8 +62,12 @@ void probe(const std::string& path, const std::vector<std::string>& sets, bool a
   const int n = model.mesh().n_nodes;
   double cx = 0, cy = 0;
   for (int i = 0; i < n; ++i) cx += x(i, 0) / n, cy += x(i, 1) / n;
-  std::printf("# %s at t = %.9g s; plane z = %g m; axis through the node centroid (%.6g, %.6g) m\n",
-              path.c_str(), c.scalar("stepper.t"), plane_z, cx, cy);
+  // What was probed goes to stderr: stdout is plain CSV (a '#' line would be taken for the header by numpy's
+  // genfromtxt(names=True) and by csv.reader).
+  std::fprintf(
+      stderr,
+      "contact-probe: %s at t = %.9g s; plane z = %g m; axis through the node centroid (%.6g, %.6g) m\n",
+      path.c_str(), c.scalar("stepper.t"), plane_z, cx + 0.0, cy + 0.0);
   std::printf(
       "triangle,r_m,z_min_m,z_max_m,normal_z,sphere_radius_m,sphere_overlap_m,regime,load_N,"
       "node0,node1,node2,z0_m,z1_m,z2_m,f0_N,f1_N,f2_N,contact_area_m2\n");
@@ -76,9 +80,11 @@ void probe(const std::string& path, const std::vector<std::string>& sets, bool a
       r += std::hypot(x(i, 0) - cx, x(i, 1) - cy) / 3;
     }
     std::printf("%d,%.6e,%.6e,%.6e,%.6f,%.6e,%.6e,%d,%.17g,%d,%d,%d,%.6e,%.6e,%.6e,%.17g,%.17g,%.17g,%.17g\n",
-                t, r, std::min({z[0], z[1], z[2]}), std::max({z[0], z[1], z[2]}), normal(t, 2), radius(t),
-                radius(t) - (centre(t, 2) - plane_z), regime(t), load(t), tri(t, 0), tri(t, 1), tri(t, 2),
-                z[0], z[1], z[2], node_load(t, 0), node_load(t, 1), node_load(t, 2), area_c(t));
+                t, r, std::min({z[0], z[1], z[2]}), std::max({z[0], z[1], z[2]}), normal(t, 2) + 0.0,
+                radius(t), radius(t) - (centre(t, 2) - plane_z), regime(t), load(t) + 0.0, tri(t, 0),
+                tri(t, 1), tri(t, 2), z[0], z[1], z[2], node_load(t, 0) + 0.0, node_load(t, 1) + 0.0,
+                node_load(t, 2) + 0.0,
+                area_c(t));  // + 0.0: no "-0" in the CSV
   }
 }
 
@@ -86,7 +92,8 @@ void probe(const std::string& path, const std::vector<std::string>& sets, bool a
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "contact-probe: per-triangle contact of a spread checkpoint with the plane, as CSV on stdout\n"
+      "contact-probe: per-triangle contact of a spread checkpoint with the plane, as CSV on stdout (what\n"
+      "was probed: one line on stderr)\n"
       "(regime 0 none, 1 gap branch, 2 quadrature/exact, 3 small disc, 4 full contact; loads repulsive > 0)",
       "contact-probe"};
   std::string path;

@@ -1,11 +1,15 @@
 #!/usr/bin/env python3
 """Checks contact-probe's CSV against the run it probes: eq. 19 keeps each triangle's load (the three node
-loads sum to it), and the triangles' contact areas add up to the run's final contact area pi r_cc^2 (1%: one step apart).
+loads sum to it), the triangles' contact areas add up to the run's final contact area pi r_cc^2 (1%: one step apart), and
+the output is plain CSV (header first, no comment line, no nan or -0).
 usage: check_contact_probe.py PROBE.csv RUN_DIR"""
 import csv, json, math, sys
 
 probe, run = sys.argv[1], sys.argv[2]
-rows = list(csv.DictReader(line for line in open(probe) if not line.startswith("#")))
+lines = open(probe).read().splitlines()
+assert lines and lines[0].startswith("triangle,"), f"stdout is not plain CSV: first line {lines[:1]}"
+assert not any("nan" in line.lower() or ",-0," in line for line in lines), "nan or -0 in the CSV"
+rows = list(csv.DictReader(lines))
 assert rows, "no triangle in contact"
 worst = 0.0
 for r in rows:
