@@ -5,8 +5,9 @@
 // z
 // (--squash, the rest state unchanged) it ends biconcave. Outputs in --out: summary.json (area, volume,
 // reduced volume, diameter, centre and largest thickness, against the Evans–Fung cell), profile.csv
-// (thickness against the distance from the axis), shape.csv (the node positions). docs/VALIDATION.md,
-// "Biconcave start".
+// (thickness against the distance from the axis), shape.csv (the node positions), deflate.h5/.xmf (the mesh
+// with two frames, the squashed start and the equilibrium, for ParaView). docs/VALIDATION.md, "Biconcave
+// start".
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
@@ -20,6 +21,7 @@
 #include "apps/common/app_cli.hpp"
 #include "apps/common/mechanics_setup.hpp"
 #include "core/errors.hpp"
+#include "core/h5_output.hpp"
 #include "core/host_copy.hpp"
 #include "core/json_writer.hpp"
 #include "core/scene.hpp"
@@ -34,6 +36,7 @@ struct Options {
   double volume_fraction = 0.644;  // the Evans–Fung cell's reduced volume
   double squash = 0.45;            // z scale of the start (1: the sphere itself)
   std::string out = "out/deflate";
+  int threads = 0;
   bool quiet = false;
 };
 
@@ -58,6 +61,8 @@ void run(const Options& o) {
   std::filesystem::create_directories(o.out, ec);
   if (ec || !std::filesystem::is_directory(o.out))
     throw dcm::IoError("--out " + o.out + ": cannot create the folder (" + ec.message() + ")");
+  dcm::remove_earlier_outputs(o.out,
+                              {"summary.json", "profile.csv", "shape.csv", "deflate.h5", "deflate.xmf"});
   dcm::Scene scene = dcm::Scene::defaults();  // Table 1 cortex
   scene.set("mesh.nodes=" + std::to_string(o.nodes));
   scene.set("contact.plane=false");
@@ -70,6 +75,7 @@ void run(const Options& o) {
     for (std::size_t i = 0; i < x.extent(0); ++i) x(i, 2) *= o.squash;
     Kokkos::deep_copy(model.positions(), x);
   }
+  const std::vector<double> x_start = dcm::to_host_vector(model.positions());
   model.scale_rest_volume(o.volume_fraction);
   dcm::NewtonSettings ns;
   ns.force_tol = 1e-16;
@@ -121,6 +127,16 @@ void run(const Options& o) {
     shape << line;
   }
   if (!prof || !shape) throw dcm::IoError(o.out + ": cannot write profile.csv / shape.csv");
+  {  // deflate.h5/.xmf: the mesh, frame 0 the squashed start, frame 1 the equilibrium (time = frame index)
+    std::vector<int> tri, node_cell(n, 0);
+    for (const dcm::Tri& t : sphere.triangles) tri.insert(tri.end(), t.begin(), t.end());
+    dcm::H5Output h5(o.out + "/deflate.h5");
+    h5.write_text("scene", scene.to_toml());
+    h5.write_mesh(x_start.data(), n, tri.data(), static_cast<int>(sphere.triangles.size()), node_cell.data());
+    h5.write_frame(0.0, x_start.data(), {});
+    h5.write_frame(1.0, x.data(), {});
+    h5.close();
+  }
   const double sphere_area = 4 * pi * std::pow(scene.get_real("mesh.radius_m"), 2);
   dcm::JsonObject json;
   json.add("nodes", n)
@@ -167,9 +183,11 @@ int main(int argc, char** argv) {
                  "target volume / sphere volume, 0.3 .. 1 (default 0.644)");
   app.add_option("--squash", o.squash, "z scale of the start, 0.1 .. 1 (1: the sphere; default 0.45)");
   app.add_option("--out", o.out, "output folder (default out/deflate)");
+  app.add_option("--threads", o.threads, "host threads (default: OMP_NUM_THREADS, else all cores)")
+      ->check(CLI::Range(0, 4096));
   app.add_flag("--quiet", o.quiet, "print only errors");
   return dcm::run_app(app, argc, argv, [&] {
-    dcm::KokkosSession kokkos(0);
+    dcm::KokkosSession kokkos(o.threads);
     run(o);
   });
 }

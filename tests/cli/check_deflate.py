@@ -1,9 +1,13 @@
 #!/usr/bin/env python3
 """Checks deflate's 642-node result: Newton converged, the target reduced volume reached (the area is kept
 by the area terms, the volume by the volume term), and the shape is biconcave (thinner at the centre than at
-its thickest), as the paper's deflated start is.
+its thickest), as the paper's deflated start is; deflate.h5 holds the mesh and two frames (start, equilibrium),
+the last one the positions of shape.csv.
 usage: check_deflate.py OUT_DIR"""
-import csv, json, sys
+import csv, json, os, sys
+
+os.environ.setdefault("HDF5_USE_FILE_LOCKING", "FALSE")
+import h5py  # noqa: E402
 
 out = sys.argv[1]
 s = json.load(open(out + "/summary.json"))
@@ -14,6 +18,14 @@ assert s["biconcave"] and s["thickness_centre_m"] < 0.5 * s["thickness_max_m"], 
 rows = list(csv.DictReader(open(out + "/profile.csv")))
 t = [float(r["thickness_m"]) for r in rows]
 assert t[0] < max(t) and t[-1] < max(t), t  # a dimple in the middle and a rim that closes at the edge
-assert sum(1 for _ in open(out + "/shape.csv")) == s["nodes"] + 1
+shape = [[float(v) for v in r.values()] for r in csv.DictReader(open(out + "/shape.csv"))]
+assert len(shape) == s["nodes"]
+with h5py.File(out + "/deflate.h5", "r") as h5:
+    frames = sorted(h5["frames"])
+    assert len(frames) == 2, frames
+    assert h5["mesh"]["triangles"].shape == (2 * s["nodes"] - 4, 3)
+    x = h5["frames"][frames[-1]]["x"][:]
+    assert x.shape == (s["nodes"], 3)
+    assert max(abs(a - b) for row, ref in zip(x, shape) for a, b in zip(row, ref)) < 1e-15, "frame 1 != shape.csv"
 print(f"reduced volume {s['reduced_volume']:.3f}, area {s['area_over_sphere']:.4f} of the sphere's, thickness "
       f"{s['thickness_centre_m'] * 1e6:.2f} um at the centre, {s['thickness_max_m'] * 1e6:.2f} um at the rim")
