@@ -196,7 +196,10 @@ std::string unknown_table_message(const std::string& table) {
 std::string node_text(const toml::node& node) {
   if (const auto* s = node.as_string()) return quoted(s->get());
   if (const auto* i = node.as_integer()) return std::to_string(i->get());
-  if (const auto* f = node.as_floating_point()) return format_real(f->get());
+  if (const auto* f = node.as_floating_point()) {  // a whole-number real keeps its ".0": 162.0 is not 162
+    const std::string t = format_real(f->get());
+    return t.find_first_of(".eEni") == std::string::npos ? t + ".0" : t;
+  }
   if (const auto* b = node.as_boolean()) return b->get() ? "true" : "false";
   if (node.is_table()) return "{...}";
   std::ostringstream os;

@@ -131,7 +131,10 @@ def check(xmf_path):
 
 
 def main():
-    if len(sys.argv) != 2:
+    if len(sys.argv) == 2 and sys.argv[1] in ("-h", "--help"):
+        print(__doc__)
+        return 0
+    if len(sys.argv) != 2 or sys.argv[1].startswith("-"):
         print("usage: check_xdmf.py FILE.xmf", file=sys.stderr)
         return 2
     try:

@@ -312,7 +312,7 @@ TEST(SceneParse, IntegerAcceptedForReal) {
 TEST(SceneParse, FloatRejectedForInt) {
   const std::string msg = string_error("[mesh]\nsubdivisions = 3.0\n");
   expect_one_line(msg);
-  EXPECT_TRUE(contains(msg, "mesh.subdivisions = 3 has the wrong type: expected an integer")) << msg;
+  EXPECT_TRUE(contains(msg, "mesh.subdivisions = 3.0 has the wrong type: expected an integer")) << msg;
 }
 
 TEST(SceneParse, OtherWrongTypes) {

@@ -328,7 +328,7 @@ BallResult triangulated_ball(const BounceOptions& o, const PlaneContactParams& p
       res.traj.h.push_back(c.z - R);
       if (!std::isfinite(c.z) || !std::isfinite(norm(w)))
         throw NumericalError("ball with " + std::to_string(res.nodes) +
-                             " nodes: non-finite state at t = " + std::to_string(t) + " s");
+                             " nodes: non-finite state at t = " + detail::format_real(t) + " s");
       if (res.steps > max_steps)
         throw NumericalError("ball with " + std::to_string(res.nodes) + " nodes: no rebound after " +
                              std::to_string(max_steps) + " steps in bounce " + std::to_string(b + 1));

@@ -78,6 +78,10 @@ inline TimeStepSettings steps_from_scene(const Scene& scene) {
   s.dt_min = scene.get_real("time.dt_min_s");
   s.dt_max = scene.get_real("time.dt_max_s");
   s.contact_change = scene.get_real("time.contact_change");
+  if (s.adaptive && !(s.dt_min <= s.dt_max))
+    throw SceneError("time.dt_min_s = " + detail::format_real(s.dt_min) +
+                     " is not allowed with time.adaptive = true: it must not exceed time.dt_max_s = " +
+                     detail::format_real(s.dt_max));
   if (s.adaptive && !(s.dt_min <= s.dt && s.dt <= s.dt_max))
     throw SceneError("time.dt_s = " + detail::format_real(s.dt) +
                      " is not allowed with time.adaptive = true: it must "

@@ -120,7 +120,7 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
       model.compute_forces();
       r = model.solve_velocity(cg, dt);
     } catch (const NumericalError& e) {
-      throw NumericalError("step " + std::to_string(step) + " (t = " + std::to_string(t) +
+      throw NumericalError("step " + std::to_string(step) + " (t = " + detail::format_real(t) +
                            " s): " + e.what());
     }
     cg_total += r.iterations;
@@ -190,13 +190,17 @@ int main(int argc, char** argv) {
   dcm::add_common_options(app, options,
                           {"", "--set mesh.nodes=642 --duration-s 0.6 --out out/relax642",
                            "scenes/relax.toml --hold-force-pN 20"});
-  app.add_option("--hold-force-pN", ro.hold_force_pN, "Force holding the cell before the release (pN)");
-  app.add_option("--duration-s", ro.duration_s, "Simulated time after the release (s)");
+  app.add_option(
+      "--hold-force-pN", ro.hold_force_pN,
+      "Force holding the cell before the release (pN), > 0 .. 10000 (default 13: D_A ≈ 8.9 um, the "
+      "paper's hold)");
+  app.add_option("--duration-s", ro.duration_s,
+                 "Simulated time after the release (s), > 0 .. 100 (default 0.6)");
   app.add_option("--pulled-fraction", ro.pulled_fraction,
                  "Fraction of all nodes held at each end (default 0.025: 5% of the nodes in total)")
       ->check(CLI::Range(0.001, 0.25));
   app.add_flag("--no-plot", ro.no_plot, "Do not draw relax.png");
-  app.add_option("--sample-every", ro.sample_every, "Steps between rows of series.csv")
+  app.add_option("--sample-every", ro.sample_every, "Steps between rows of series.csv (default 100)")
       ->check(CLI::Range(1, 1000000));
   return dcm::run_app(app, argc, argv, [&] { dcm::run(options, ro); });
 }

@@ -675,8 +675,8 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
       });
     } catch (const NumericalError& e) {
       const Member& m = ms.front();
-      stop_on_numerical_trouble(ms, (ms.size() == 1 ? "step " + std::to_string(m.index) +
-                                                          " (t = " + std::to_string(stepper.time(0)) + " s): "
+      stop_on_numerical_trouble(ms, (ms.size() == 1 ? "step " + std::to_string(m.index) + " (t = " +
+                                                          detail::format_real(stepper.time(0)) + " s): "
                                                     : "batch step " + std::to_string(batch_steps) + ": ") +
                                         e.what());
     }
@@ -718,7 +718,8 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
                     t1 = model.mesh().host_cell_tri_begin[m.cell + 1];
           int bad = t0;
           while (bad < t1 && tri_area_c[bad] >= 0) ++bad;
-          stop_on_numerical_trouble(ms, "step " + std::to_string(m.index) + " (t = " + std::to_string(t + h) +
+          stop_on_numerical_trouble(ms, "step " + std::to_string(m.index) +
+                                            " (t = " + detail::format_real(t + h) +
                                             " s): the contact area is " + detail::format_real(area_c) +
                                             " m² (first at triangle " + std::to_string(bad - t0) + ")" +
                                             (ms.size() > 1 ? " of member " + m.out_dir : std::string()));
