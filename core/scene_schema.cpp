@@ -117,7 +117,8 @@ std::vector<ParamSpec> make_schema() {
                "cell density minus medium density (RBC in plasma ≈ 1100 − 1025)"),
 
       bool_key("contact.plane", "false",
-               "a substrate plane z = contact.plane_z_m with adhesion (contact.law) and substrate friction"),
+               "a substrate plane z = contact.plane_z_m with adhesion (contact.law) and substrate friction "
+               "(spread: true unless the scene sets false)"),
       real_key("contact.plane_z_m", "0", -1e-3, 1e-3, kIncl, "m", "height of the substrate plane"),
       string_key("contact.law", "maugis_dugdale", {"maugis_dugdale", "derjaguin"},
                  "the adhesion model: maugis_dugdale = the paper's rounded triangles with the Maugis–Dugdale "

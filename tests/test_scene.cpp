@@ -439,7 +439,7 @@ TEST(SceneSet, Errors) {
   EXPECT_EQ(set_error("mesh.subdivisions=four"),
             "--set: mesh.subdivisions = four has the wrong type: expected an integer");
   EXPECT_EQ(set_error("mesh.subdivisions=3.0"),
-            "--set: mesh.subdivisions = 3 has the wrong type: expected an integer");
+            "--set: mesh.subdivisions = 3.0 has the wrong type: expected an integer");
   EXPECT_EQ(set_error("mesh.shape=cube"),
             "--set: mesh.shape = \"cube\" is not allowed: choose one of sphere, evans_fung");
   EXPECT_EQ(set_error("output.hdf5=yes"),

@@ -79,7 +79,7 @@ void probe(const std::string& path, const std::vector<std::string>& sets, bool a
       z[k] = x(i, 2) - plane_z;
       r += std::hypot(x(i, 0) - cx, x(i, 1) - cy) / 3;
     }
-    std::printf("%d,%.6e,%.6e,%.6e,%.6f,%.6e,%.6e,%d,%.17g,%d,%d,%d,%.6e,%.6e,%.6e,%.17g,%.17g,%.17g,%.17g\n",
+    std::printf("%d,%.6e,%.6e,%.6e,%.9g,%.6e,%.6e,%d,%.17g,%d,%d,%d,%.6e,%.6e,%.6e,%.17g,%.17g,%.17g,%.17g\n",
                 t, r, std::min({z[0], z[1], z[2]}), std::max({z[0], z[1], z[2]}), normal(t, 2) + 0.0,
                 radius(t), radius(t) - (centre(t, 2) - plane_z), regime(t), load(t) + 0.0, tri(t, 0),
                 tri(t, 1), tri(t, 2), z[0], z[1], z[2], node_load(t, 0) + 0.0, node_load(t, 1) + 0.0,

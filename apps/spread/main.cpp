@@ -170,7 +170,15 @@ double fit_exponent(const std::vector<double>& t, const std::vector<double>& r, 
 // The scene of a run: from the file and --set, or, for a restart, from its checkpoint with only the keys
 // that do not change the physics allowed to change (a longer t_end, output settings).
 Scene spread_scene(const AppOptions& options, const SpreadOptions& so, const Checkpoint* restart) {
-  if (!restart) return load_scene(options, {"name=spread", "contact.plane=true"});
+  if (!restart) {
+    Scene scene = load_scene(options, {"name=spread", "contact.plane=true"});
+    if (!scene.was_set(
+            "contact.plane")) {  // spread's own default, also under a scene file that leaves it out
+      scene.set("contact.plane=true");
+      scene.validate();
+    }
+    return scene;
+  }
   if (!options.scene_path.empty())
     throw SceneError("--restart " + so.restart +
                      ": a restart takes its scene from the checkpoint; give no "
@@ -181,15 +189,18 @@ Scene spread_scene(const AppOptions& options, const SpreadOptions& so, const Che
   Scene scene = Scene::from_string(restart->text("scene"), so.restart);
   for (const std::string& set : options.sets) {
     const std::string key = set.substr(0, set.find('='));
-    if (key != "time.t_end_s" && key.rfind("output.", 0) != 0)
-      throw SceneError("--set " + set +
-                       " with --restart: only time.t_end_s and output.* may change on a "
-                       "restart (the rest would not continue the same run)");
+    if ((key != "time.t_end_s" && key.rfind("output.", 0) != 0) || key == "output.hdf5")
+      throw SceneError(
+          "--set " + set +
+          " with --restart: only time.t_end_s and output.* (but output.hdf5) may change on a "
+          "restart (the rest would not continue the same run; spread.h5 continues or stays absent)");
     scene.set(set);
   }
   scene.validate();
+  // t_end = the checkpoint's time finishes the run without a step (a run killed between its last checkpoint
+  // and its summary: scan resumes such members); an earlier t_end cannot continue it.
   const double t_done = restart->scalar("stepper.t");
-  if (!(scene.get_real("time.t_end_s") > t_done))
+  if (scene.get_real("time.t_end_s") < t_done * (1 - 1e-12))
     throw SceneError("time.t_end_s = " + detail::format_real(scene.get_real("time.t_end_s")) +
                      " is not allowed with --restart " + so.restart + ": the checkpoint is at t = " +
                      detail::format_real(t_done) + " s; continue with --set time.t_end_s=<a later time>");
@@ -251,7 +262,9 @@ void prepare_member(Member& m) {
   m.scene = spread_scene(m.options, so, m.restart ? &*m.restart : nullptr);
   const Scene& scene = m.scene;
   if (!scene.get_bool("contact.plane"))
-    throw SceneError("contact.plane = false: spread needs the substrate plane (set contact.plane = true)");
+    throw SceneError(
+        "contact.plane = false: spread needs the substrate plane (set contact.plane = true, or leave "
+        "the key out)");
   if (!(so.early_from_s > 0 && so.early_to_s > so.early_from_s))
     throw SceneError("--early-window-s = " + detail::format_real(so.early_from_s) + "," +
                      detail::format_real(so.early_to_s) + " is not allowed: need 0 < from < to");
@@ -525,7 +538,8 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
   }
   if (ms.front().so.check) {  // everything above would have stopped a bad run; nothing is written
     for (const Member& m : ms)
-      std::printf("spread: scene %s: ok (checked, nothing written)\n", m.scene.name().c_str());
+      if (!m.options.quiet)
+        std::printf("spread: scene %s: ok (checked, nothing written)\n", m.scene.name().c_str());
     return;
   }
   for (Member& m : ms) {
@@ -534,12 +548,13 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
     if (m.out_dir.empty()) m.out_dir = ".";
     m.checkpoint_path = m.out_dir + "/checkpoint.h5";
     m.wrote_checkpoint = m.restart.has_value();
+    m.csv_tmp = m.out_dir + "/series.csv.part";
+  }
+  for (Member& m : ms)  // only once every member's folder is there: a refused batch removes nothing
     if (!m.restart)
       remove_earlier_outputs(
           m.out_dir, {"summary.json", "series.csv", "series.csv.part", "spread.h5", "spread.xmf",
                       "checkpoint.h5", "checkpoint.h5.tmp", "r_cc.png", "cells.png", "side_views.png"});
-    m.csv_tmp = m.out_dir + "/series.csv.part";
-  }
   KokkosSession kokkos(threads);
   const auto wall0 = std::chrono::steady_clock::now();
 
@@ -577,8 +592,18 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
       m.areas_c = c.array("app.contact_area_m2", m.ts.size());
       m.heights = c.array("app.height_m", m.ts.size());
       m.csv_text = c.text("app.series_csv");
-      m.series_rows =
-          c.arrays.count("app.series_rows") ? c.array("app.series_rows") : parse_series_rows(m.csv_text);
+      if (c.arrays.count("app.series_rows")) {
+        m.series_rows = c.array("app.series_rows");
+      } else {  // a checkpoint from before session 15: the CSV's digits, and the exact columns it kept
+        m.series_rows = parse_series_rows(m.csv_text);
+        const std::size_t w = kSeriesColumns.size();
+        for (std::size_t i = 0; i < m.ts.size() && (i + 1) * w <= m.series_rows.size(); ++i) {
+          m.series_rows[i * w + 0] = m.ts[i];
+          m.series_rows[i * w + 1] = m.rs[i];
+          m.series_rows[i * w + 2] = m.areas_c[i];
+          m.series_rows[i * w + 7] = m.heights[i];
+        }
+      }
       m.frames_before = static_cast<int>(c.scalar("app.frames"));
     }
     std::vector<int> tri, node_cell(m.n, 0);
@@ -832,11 +857,11 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
   std::signal(SIGTERM, SIG_DFL);
   for (const Member& m : ms)
     if (m.interrupted)
-      throw AppInterrupted(
-          "interrupted at t = " + std::to_string(stepper.time(m.cell)) + " s; " + m.out_dir +
-          "/spread.h5, series.csv and summary.json hold what was done; continue with: spread "
-          "--restart " +
-          m.checkpoint_path);
+      throw AppInterrupted("interrupted at t = " + detail::format_real(stepper.time(m.cell)) + " s; " +
+                           m.out_dir + "/" + (m.h5 ? "spread.h5, " : "") +
+                           "series.csv and summary.json hold what was done; continue with: spread "
+                           "--restart " +
+                           m.checkpoint_path);
 }
 
 // Splits a member line into words; "double quotes" keep spaces.

@@ -3,12 +3,14 @@
 loads sum to it), the triangles' contact areas add up to the run's final contact area pi r_cc^2 (1%: one step apart), and
 the output is plain CSV (header first, no comment line, no nan or -0).
 usage: check_contact_probe.py PROBE.csv RUN_DIR"""
-import csv, json, math, sys
+import csv, json, math, re, sys
 
 probe, run = sys.argv[1], sys.argv[2]
 lines = open(probe).read().splitlines()
 assert lines and lines[0].startswith("triangle,"), f"stdout is not plain CSV: first line {lines[:1]}"
-assert not any("nan" in line.lower() or ",-0," in line for line in lines), "nan or -0 in the CSV"
+negative_zero = re.compile(r"-0(\.0*)?([eE][-+]?0+)?")
+assert not any("nan" in line.lower() or any(negative_zero.fullmatch(f) for f in line.split(",")) for line in lines), \
+    "nan or -0 in the CSV"
 rows = list(csv.DictReader(lines))
 assert rows, "no triangle in contact"
 worst = 0.0
