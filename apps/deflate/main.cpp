@@ -38,6 +38,7 @@ struct Options {
   std::string out = "out/deflate";
   int threads = 0;
   bool quiet = false;
+  std::vector<std::string> sets;  // cortex.* overrides of the deflation's constants
 };
 
 int level_of(int nodes) {
@@ -66,6 +67,11 @@ void run(const Options& o) {
   dcm::Scene scene = dcm::Scene::defaults();  // Table 1 cortex
   scene.set("mesh.nodes=" + std::to_string(o.nodes));
   scene.set("contact.plane=false");
+  for (const std::string& set : o.sets) {
+    if (set.rfind("cortex.", 0) != 0)
+      throw dcm::SceneError("--set " + set + ": deflate takes cortex.* keys only (the mesh: --nodes)");
+    scene.set(set);
+  }
   scene.validate();
   const dcm::HostMesh sphere = dcm::cell_mesh_from_scene(scene);
   dcm::CortexModel<Exec> model(Exec(), {dcm::HostCell(sphere)}, dcm::mechanics_from_scene(scene));
@@ -142,6 +148,7 @@ void run(const Options& o) {
   json.add("nodes", n)
       .add("volume_fraction_target", o.volume_fraction)
       .add("squash", o.squash)
+      .add("sets", o.sets)
       .add("newton_steps", r.newton_steps)
       .add("max_force_N", r.max_force)
       .add("area_m2", area)
@@ -186,6 +193,10 @@ int main(int argc, char** argv) {
   app.add_option("--threads", o.threads, "host threads (default: OMP_NUM_THREADS, else all cores)")
       ->check(CLI::Range(0, 4096));
   app.add_flag("--quiet", o.quiet, "print only errors");
+  app.add_option("--set", o.sets,
+                 "KEY=VALUE: a cortex.* constant of the deflation (e.g. softer springs: --set "
+                 "cortex.k_s_N_per_m=3.2e-8); default Table 1")
+      ->type_name("KEY=VALUE");
   return dcm::run_app(app, argc, argv, [&] {
     dcm::KokkosSession kokkos(o.threads);
     run(o);
