@@ -58,12 +58,6 @@ void run(const Options& o) {
   if (!(o.squash >= 0.1 && o.squash <= 1))
     throw dcm::SceneError("--squash = " + dcm::detail::format_real(o.squash) +
                           " is out of range: allowed 0.1 .. 1");
-  std::error_code ec;
-  std::filesystem::create_directories(o.out, ec);
-  if (ec || !std::filesystem::is_directory(o.out))
-    throw dcm::IoError("--out " + o.out + ": cannot create the folder (" + ec.message() + ")");
-  dcm::remove_earlier_outputs(o.out,
-                              {"summary.json", "profile.csv", "shape.csv", "deflate.h5", "deflate.xmf"});
   dcm::Scene scene = dcm::Scene::defaults();  // Table 1 cortex
   scene.set("mesh.nodes=" + std::to_string(o.nodes));
   scene.set("contact.plane=false");
@@ -73,6 +67,12 @@ void run(const Options& o) {
     scene.set(set);
   }
   scene.validate();
+  std::error_code ec;
+  std::filesystem::create_directories(o.out, ec);
+  if (ec || !std::filesystem::is_directory(o.out))
+    throw dcm::IoError("--out " + o.out + ": cannot create the folder (" + ec.message() + ")");
+  dcm::remove_earlier_outputs(o.out,
+                              {"summary.json", "profile.csv", "shape.csv", "deflate.h5", "deflate.xmf"});
   const dcm::HostMesh sphere = dcm::cell_mesh_from_scene(scene);
   dcm::CortexModel<Exec> model(Exec(), {dcm::HostCell(sphere)}, dcm::mechanics_from_scene(scene));
   model.set_flat_bending_rest();
