@@ -329,7 +329,11 @@ H5Output::H5Output(const std::string& h5_path, Resume resume) : impl_(nullptr), 
   impl->xdmf_path = xdmf_path_;
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   std::error_code ec;
-  if (!fs::is_regular_file(h5_path, ec)) impl->fail("cannot continue: the file of the run is missing");
+  if (!fs::is_regular_file(h5_path, ec))
+    impl->fail(
+        "cannot continue: the file of the run is missing (a checkpoint continues in its run's folder, beside "
+        "the "
+        "run's HDF5 file: copy the folder, not the checkpoint alone)");
   const hid_t id = H5Fopen(h5_path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
   if (id < 0) impl->fail("cannot continue the file (" + create_failure_reason(h5_path) + ")");
   Impl& m = *impl;

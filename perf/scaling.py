@@ -18,6 +18,9 @@ from collections import defaultdict
 
 def main():
     args = sys.argv[1:]
+    if not args or any(a in ("-h", "--help") for a in args):
+        print(__doc__)
+        return 0 if args else 2
     lo, hi = 2562, 40962
     if "--from" in args:
         i = args.index("--from")
@@ -60,4 +63,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -47,6 +47,9 @@ def group_of(kernel):
 
 
 def main():
+    if len(sys.argv) < 2 or sys.argv[1] in ("-h", "--help") or sys.argv[1].startswith("-"):
+        print(__doc__)
+        return 0 if len(sys.argv) > 1 and sys.argv[1] in ("-h", "--help") else 2
     path = sys.argv[1]
     col = "ns_per_node" if "--ns" in sys.argv else "us_per_step"
     data = defaultdict(lambda: defaultdict(float))  # (scene, nodes) -> backend -> group -> value
@@ -77,4 +80,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -519,4 +519,8 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    try:
+        sys.exit(main())
+    except KeyboardInterrupt:  # Ctrl-C before the members run (while they are checked): nothing was started
+        print(f"{PROG}: stopped before any member ran; run the same command again", file=sys.stderr)
+        sys.exit(130)

@@ -189,11 +189,13 @@ Scene spread_scene(const AppOptions& options, const SpreadOptions& so, const Che
   Scene scene = Scene::from_string(restart->text("scene"), so.restart);
   for (const std::string& set : options.sets) {
     const std::string key = set.substr(0, set.find('='));
-    if ((key != "time.t_end_s" && key.rfind("output.", 0) != 0) || key == "output.hdf5")
+    if ((key != "time.t_end_s" && key.rfind("output.", 0) != 0) || key == "output.hdf5" ||
+        key == "output.dir")
       throw SceneError(
           "--set " + set +
-          " with --restart: only time.t_end_s and output.* (but output.hdf5) may change on a "
-          "restart (the rest would not continue the same run; spread.h5 continues or stays absent)");
+          " with --restart: only time.t_end_s and output.* (but output.hdf5 and output.dir) may "
+          "change on a restart (the rest would not continue the same run; the run continues in its "
+          "folder, its spread.h5 continues or stays absent)");
     scene.set(set);
   }
   scene.validate();
@@ -258,6 +260,11 @@ void prepare_member(Member& m) {
     m.restart = read_checkpoint(so.restart);
     if (m.restart->text("app") != "spread")
       throw IoError(so.restart + ": a checkpoint of '" + m.restart->text("app") + "', not of spread");
+    const double steps_done = m.restart->array("app.progress").at(0);  // Progress::step
+    if (so.max_steps > 0 && static_cast<double>(so.max_steps) <= steps_done)
+      throw SceneError("--max-steps " + std::to_string(so.max_steps) + " is not allowed with --restart " +
+                       so.restart + ": the run has done " + detail::format_real(steps_done) +
+                       " steps (--max-steps counts from the run's start); give a larger count");
   }
   m.scene = spread_scene(m.options, so, m.restart ? &*m.restart : nullptr);
   const Scene& scene = m.scene;
@@ -853,8 +860,13 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
   // The final state of the members still open (interrupted or stopped at --max-steps).
   for (Member& m : ms)
     if (!m.done) finish_member(m, model, stepper, fields, seconds_since(wall0));
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
+  // The handlers stay: a second SIGINT while the files are closed (scan forwards its own to each member) must
+  // not kill the process before it exits with 130.
+  for (const Member& m : ms)
+    if (m.stopped_at_max_steps && !m.options.quiet)
+      std::printf("  stopped after --max-steps %lld at t = %s s; continue with: spread --restart %s\n",
+                  m.so.max_steps, detail::format_real(stepper.time(m.cell)).c_str(),
+                  m.checkpoint_path.c_str());
   for (const Member& m : ms)
     if (m.interrupted)
       throw AppInterrupted("interrupted at t = " + detail::format_real(stepper.time(m.cell)) + " s; " +
