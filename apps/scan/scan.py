@@ -441,6 +441,16 @@ def main():
         status = {m["id"]: "done" for m in members if all(m["id"] != q["id"] for q in queue)}
         threads = a.threads or max(1, per_rank_cores // max(1, min(jobs, n_todo)))
         if not a.quiet:
+            changed = [m["id"] for m in queue if os.path.isfile(os.path.join(out, "members", m["id"], "member.json"))
+                       and member_state(os.path.join(out, "members", m["id"]), m) == "new"]
+            if changed:
+                print(f"{PROG}: {len(changed)} member folder(s) hold a run of other settings (the scan file changed): "
+                      f"run again: {' '.join(changed[:10])}{' ...' if len(changed) > 10 else ''}", flush=True)
+            ids = {m["id"] for m in members}
+            extra = sorted(d for d in os.listdir(os.path.join(out, "members")) if d not in ids)
+            if extra:
+                print(f"{PROG}: members/ also holds {' '.join(extra[:10])}{' ...' if len(extra) > 10 else ''}: not "
+                      f"members of this scan, left as they are and not in its results", flush=True)
             where = f"; {size} MPI ranks" if comm else ""
             print(f"{PROG}: {scan['name']}: {len(members)} members, {len(members) - n_todo} already done; {jobs} at a "
                   f"time, {threads} thread(s) each{where} -> {out}", flush=True)
@@ -487,6 +497,8 @@ def main():
         write_h5(scan, out, rows)
         if not a.no_plot and not stop:
             plot(scan, out)
+        elif os.path.isfile(os.path.join(out, "r_cc_grid.png")):  # an earlier scan's plot: not of these results
+            os.remove(os.path.join(out, "r_cc_grid.png"))
         if not a.quiet:
             print(f"{PROG}: wrote {out}/summary.csv, {out}/scan.h5 ({time.time() - t0:.1f} s)", flush=True)
         warned = [r["id"] for r in rows if r.get("warnings") not in ("", 0)]
