@@ -102,8 +102,11 @@ int main(int argc, char** argv) {
   app.add_option("CHECKPOINT", path, "checkpoint.h5 written by spread")->required();
   app.add_option("--set", sets, "KEY=VALUE: change a contact.*, geometry.*, cortex.E_Pa or cortex.nu key");
   app.add_flag("--all", all, "every triangle, also those without contact");
+  int threads = 0;
+  app.add_option("--threads", threads, "Host threads (default: OMP_NUM_THREADS, else all cores)")
+      ->check(CLI::Range(0, 4096));
   return dcm::run_app(app, argc, argv, [&] {
-    dcm::KokkosSession kokkos(0);
+    dcm::KokkosSession kokkos(threads);
     probe(path, sets, all);
   });
 }
