@@ -648,10 +648,12 @@ class CortexModel {
   std::string describe_overstretch(int bond) const {
     auto b = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh_.bond);
     auto cell = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh_.bond_cell);
+    char x_max[32];
+    std::snprintf(x_max, sizeof x_max, "%g", cell_params_.at(cell(bond)).bonds.x_max);
     return "FENE bond " + std::to_string(bond) + " (nodes " + std::to_string(b(bond, 0)) + "-" +
            std::to_string(b(bond, 1)) + (mesh_.n_cells > 1 ? ", cell " + std::to_string(cell(bond)) : "") +
-           ") reached its maximum length d_max = x_max d* (x_max = " +
-           std::to_string(cell_params_.at(cell(bond)).bonds.x_max) + "); reduce the time step or the load";
+           ") reached its maximum length d_max = x_max d* (x_max = " + x_max +
+           "); reduce the time step or the load";
   }
 
   // The per-cell constant tables the kernels read (core/cell_params.hpp).

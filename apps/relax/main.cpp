@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -86,8 +87,13 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
   NewtonSettings ns;
   ns.force_tol = 1e-4 * ro.hold_force_pN * 1e-12 / left.size();
   const NewtonResult held = newton_equilibrium(model, ns, mean_edge_length(mesh, build_topology(mesh)));
-  if (!held.converged)
-    throw NumericalError("the stretched cell did not reach equilibrium before the release");
+  if (!held.converged) {
+    std::error_code ec;  // nothing was written yet: no empty folder left behind
+    if (std::filesystem::is_empty(out, ec)) std::filesystem::remove(out, ec);
+    throw NumericalError("the stretched cell did not reach equilibrium before the release (" +
+                         std::to_string(held.newton_steps) + " Newton steps, largest node force " +
+                         detail::format_real(held.max_force) + " N): try a smaller --hold-force-pN");
+  }
   const auto [da0, dt0] = axial_transverse_diameters(to_host_vector(model.positions()));
   if (!options.quiet)
     std::printf("dcm relax: %d nodes, held at %.3g pN: D_A = %.3f um, D_T = %.3f um; released; %s\n", n,

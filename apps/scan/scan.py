@@ -44,6 +44,11 @@ def sweep_values(key, spec):
     if isinstance(spec, list):
         if not spec:
             raise ScanError(f"sweep.{key} = [] is empty: give at least one value")
+        seen = []
+        for v in spec:
+            if v in seen:  # two identical members: the same run twice
+                raise ScanError(f"sweep.{key} = {spec!r}: the value {v!r} appears twice; give each value once")
+            seen.append(v)
         return spec
     if isinstance(spec, dict):
         allowed = {"start", "stop", "num", "spacing"}
