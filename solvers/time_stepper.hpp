@@ -107,10 +107,11 @@ class TimeStepper {
         h_prev2_(n_, 0.0),
         has_prev_(n_, 0),
         has_prev2_(n_, 0),
-        x_prev_(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::batch::x_prev"), model.mesh().n_nodes),
-        v_prev_(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::batch::v_prev"), model.mesh().n_nodes),
-        v_prev2_(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::batch::v_prev2"),
-                 model.mesh().n_nodes),
+        // Zeroed, not left uninitialised: a checkpoint holds them before they are first set (v_prev2_ in
+        // adaptive runs never is), and a checkpoint must hold finite numbers.
+        x_prev_("dcm::batch::x_prev", model.mesh().n_nodes),
+        v_prev_("dcm::batch::v_prev", model.mesh().n_nodes),
+        v_prev2_("dcm::batch::v_prev2", model.mesh().n_nodes),
         contact_prev_(n_, -1.0),
         contact_floor_(mean_triangle_areas(model)),
         cell_s_(std::vector<double>(n_, 0.0), "dcm::batch::factor"),

@@ -53,7 +53,7 @@ bool validate(const Options& o) {
   return ok;
 }
 
-// A CSV field: empty where the quantity is undefined (NaN), never "nan" or "-0".
+// A CSV field: empty where the quantity is undefined (NaN), never "nan", "inf" or "-0".
 std::string field(double v) {
   if (std::isnan(v)) return "";
   char b[32];
@@ -65,7 +65,7 @@ void print_row(const dcm::MdState& st, const Options& o, const dcm::MdMaterial& 
   const double L = dcm::md_length_unit(mat, o.R);
   const double lambda = dcm::md_lambda(mat, o.R);
   const double force_unit = dcm::kMdPi * mat.W * o.R;
-  const double m = st.a > 0 ? st.c / st.a : (st.c > 0 ? INFINITY : NAN);
+  const double m = st.a > 0 ? st.c / st.a : NAN;  // the gap branch (a = 0): m = c/a is undefined
   const double values[] = {
       st.a, st.delta, m, st.c, lambda, L > 0 ? st.a / L : NAN, force_unit > 0 ? st.P / force_unit : NAN,
       st.P};
@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
       "a contact radius, delta geometric overlap (a^2 = 2 R delta - delta^2; negative: gap), m = c/a, c "
       "adhesive "
       "radius, lambda Maugis' parameter, Abar = a/(pi W R^2/K)^(1/3), Pbar = P/(pi W R), P net load "
-      "(repulsive > 0). In the gap branch a = 0 and m = inf (empty beyond h0, where c = 0). With W = 0 "
+      "(repulsive > 0). In the gap branch a = 0 and m is empty (undefined; c is 0 beyond h0). With W = 0 "
       "(Hertz) "
       "Abar and Pbar are undefined: empty fields.\n"
       "Model and checks: docs/model/contact.md",
