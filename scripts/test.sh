@@ -6,8 +6,13 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 builddir=$(bash scripts/build.sh release | tail -n 1)
+echo "test.sh: build done after ${SECONDS} s" >&2
+start=$SECONDS
 (cd "$builddir" && ctest --output-on-failure --parallel "$(nproc)" "$@")
+echo "test.sh: ctest took $((SECONDS - start)) s" >&2
 # Then every unit and I/O test again, built with ASan + UBSan (about 12 minutes with the build).
 if [ "${DCM_SKIP_SANITIZE:-0}" != 1 ]; then
+  start=$SECONDS
   bash scripts/sanitize.sh
+  echo "test.sh: the sanitizer build and run took $((SECONDS - start)) s" >&2
 fi

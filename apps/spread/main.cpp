@@ -22,7 +22,6 @@
 // per-cell constants, CG and time steps. Each member's folder gets exactly the files its run alone writes,
 // with the same numbers (wall_s excepted: the batch's). Members must need the same kernels and settings
 // (mesh size, solver and time-step options); the first difference is named.
-#include <Eigen/Dense>
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -41,6 +40,7 @@
 
 #include "apps/common/app_cli.hpp"
 #include "apps/common/mechanics_setup.hpp"
+#include "apps/spread/spread_fits.hpp"
 #include "core/checkpoint.hpp"
 #include "core/h5_output.hpp"
 #include "core/host_copy.hpp"
@@ -114,58 +114,9 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// Sphere through a set of nodes (algebraic least squares |x|² = 2 c·x + d); the contact angle from the
-// centre's height h_c above the plane: θ = π − acos(h_c / R). Two node sets:
-//   paper: the top 95% of the nodes by height (the paper's method). It keeps most of the flat, adhered base
-//          (only the lowest 5% of the nodes are dropped, a third of them lie in the contact), which pulls the
-//          sphere down: on ideal caps it reads 88° for a true 65° cap and 112° for 97° (docs/VALIDATION.md).
-//   free:  the nodes higher than 10% of the cell's height: the free membrane only, the true cap angle.
-struct CapFit {
-  double radius = NAN, centre_height = NAN, angle_deg = NAN;
-};
-CapFit fit_cap(const std::vector<double>& x, double plane_z, bool free_membrane) {
-  const int n = static_cast<int>(x.size() / 3);
-  std::vector<double> z(n);
-  for (int i = 0; i < n; ++i) z[i] = x[3 * i + 2];
-  std::vector<double> sorted = z;
-  std::sort(sorted.begin(), sorted.end());
-  const double cut = free_membrane ? plane_z + 0.1 * (sorted.back() - plane_z)
-                                   : sorted[static_cast<std::size_t>(0.05 * (n - 1))];
-  Eigen::MatrixXd a(n, 4);
-  Eigen::VectorXd b(n);
-  int m = 0;
-  for (int i = 0; i < n; ++i) {
-    if (z[i] < cut) continue;
-    a.row(m) << 2 * x[3 * i], 2 * x[3 * i + 1], 2 * x[3 * i + 2], 1.0;
-    b(m) = x[3 * i] * x[3 * i] + x[3 * i + 1] * x[3 * i + 1] + x[3 * i + 2] * x[3 * i + 2];
-    ++m;
-  }
-  CapFit f;
-  if (m < 4) return f;
-  const Eigen::Vector4d s = a.topRows(m).colPivHouseholderQr().solve(b.head(m));
-  f.radius = std::sqrt(s(3) + s(0) * s(0) + s(1) * s(1) + s(2) * s(2));
-  f.centre_height = s(2) - plane_z;
-  f.angle_deg = (kPi - std::acos(std::clamp(f.centre_height / f.radius, -1.0, 1.0))) * 180 / kPi;
-  return f;
-}
-
-// Least-squares slope of log r against log t over the rows with from ≤ t ≤ to and r > 0.
-double fit_exponent(const std::vector<double>& t, const std::vector<double>& r, double from, double to,
-                    int& used) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  used = 0;
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    if (t[i] < from || t[i] > to || !(r[i] > 0)) continue;
-    const double lx = std::log(t[i]), ly = std::log(r[i]);
-    sx += lx;
-    sy += ly;
-    sxx += lx * lx;
-    sxy += lx * ly;
-    ++used;
-  }
-  if (used < 3) return NAN;
-  return (used * sxy - sx * sy) / (used * sxx - sx * sx);
-}
+using spread_fits::CapFit;
+using spread_fits::fit_cap;
+using spread_fits::fit_exponent;
 
 // The scene of a run: from the file and --set, or, for a restart, from its checkpoint with only the keys
 // that do not change the physics allowed to change (a longer t_end, output settings).

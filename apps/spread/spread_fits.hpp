@@ -1,0 +1,70 @@
+#pragma once
+// The two fits of spread's summary.json (host only): the contact angle from a sphere fitted to the cell's
+// nodes, and the early exponent of r_cc(t). Tested on ideal caps and power laws (tests/test_spread_fits.cpp).
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+namespace dcm::spread_fits {
+
+// Sphere through a set of nodes (algebraic least squares |x|² = 2 c·x + d); the contact angle from the
+// centre's height h_c above the plane: θ = π − acos(h_c / R). Two node sets:
+//   paper: the top 95% of the nodes by height (the paper's method). It keeps most of the flat, adhered base
+//          (only the lowest 5% of the nodes are dropped, a third of them lie in the contact), which pulls the
+//          sphere down and reads the angle too high (tests/test_spread_fits.cpp: ideal caps).
+//   free:  the nodes higher than 10% of the cell's height: the free membrane only, the true cap angle.
+struct CapFit {
+  double radius = NAN, centre_height = NAN, angle_deg = NAN;
+};
+
+// x: node positions, 3 per node; plane_z: the plane's height (its normal is +z).
+inline CapFit fit_cap(const std::vector<double>& x, double plane_z, bool free_membrane) {
+  constexpr double kPi = 3.14159265358979323846;
+  const int n = static_cast<int>(x.size() / 3);
+  CapFit f;
+  if (n < 4) return f;
+  std::vector<double> z(n);
+  for (int i = 0; i < n; ++i) z[i] = x[3 * i + 2];
+  std::vector<double> sorted = z;
+  std::sort(sorted.begin(), sorted.end());
+  const double cut = free_membrane ? plane_z + 0.1 * (sorted.back() - plane_z)
+                                   : sorted[static_cast<std::size_t>(0.05 * (n - 1))];
+  Eigen::MatrixXd a(n, 4);
+  Eigen::VectorXd b(n);
+  int m = 0;
+  for (int i = 0; i < n; ++i) {
+    if (z[i] < cut) continue;
+    a.row(m) << 2 * x[3 * i], 2 * x[3 * i + 1], 2 * x[3 * i + 2], 1.0;
+    b(m) = x[3 * i] * x[3 * i] + x[3 * i + 1] * x[3 * i + 1] + x[3 * i + 2] * x[3 * i + 2];
+    ++m;
+  }
+  if (m < 4) return f;
+  const Eigen::Vector4d s = a.topRows(m).colPivHouseholderQr().solve(b.head(m));
+  f.radius = std::sqrt(s(3) + s(0) * s(0) + s(1) * s(1) + s(2) * s(2));
+  f.centre_height = s(2) - plane_z;
+  f.angle_deg = (kPi - std::acos(std::clamp(f.centre_height / f.radius, -1.0, 1.0))) * 180 / kPi;
+  return f;
+}
+
+// Least-squares slope of log r against log t over the rows with from ≤ t ≤ to and r > 0; NaN with fewer than
+// three such rows (used says how many there were).
+inline double fit_exponent(const std::vector<double>& t, const std::vector<double>& r, double from, double to,
+                           int& used) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  used = 0;
+  for (std::size_t i = 0; i < t.size() && i < r.size(); ++i) {
+    if (t[i] < from || t[i] > to || !(r[i] > 0)) continue;
+    const double lx = std::log(t[i]), ly = std::log(r[i]);
+    sx += lx;
+    sy += ly;
+    sxx += lx * lx;
+    sxy += lx * ly;
+    ++used;
+  }
+  if (used < 3) return NAN;
+  return (used * sxy - sx * sy) / (used * sxx - sx * sx);
+}
+
+}  // namespace dcm::spread_fits
