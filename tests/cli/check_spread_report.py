@@ -1,0 +1,90 @@
+#!/usr/bin/env python3
+"""scripts/spread_report.py judges each claim from the runs' files: a fixture of synthetic runs (power laws of
+known exponent, summaries of known angles and heights) in WORK_DIR, one claim made to fail on purpose and one
+run left out; the report's verdicts must be exactly the expected ones.
+
+usage: check_spread_report.py SOURCE_DIR WORK_DIR
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+
+def write_run(root, name, amplitude, alpha, t_stop, t_end, **summary):
+    """A run whose r_cc = amplitude · min(t, t_stop)^alpha, sampled 20 times per decade from 1 ms to t_end."""
+    path = os.path.join(root, name)
+    os.makedirs(path)
+    rows, i = [], 0
+    while True:
+        t = 1e-3 * 10 ** (i / 20)
+        if t > t_end * (1 + 1e-12):
+            break
+        rows.append((t, amplitude * min(t, t_stop) ** alpha))
+        i += 1
+    rows.append((t_end, amplitude * min(t_end, t_stop) ** alpha))
+    with open(os.path.join(path, "series.csv"), "w") as f:
+        f.write("t_s,r_cc_m\n" + "".join(f"{t!r},{r!r}\n" for t, r in rows))
+    base = {"early_exponent": alpha, "early_window_s": [0.01, 0.1], "r_cc_final_m": rows[-1][1], "warnings": [],
+            "energy_residual_relative": 1e-5}
+    base.update(summary)
+    with open(os.path.join(path, "summary.json"), "w") as f:
+        json.dump(base, f)
+
+
+def main():
+    src, work = sys.argv[1], sys.argv[2]
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    A = 5e-6
+    write_run(work, "hategan2004_sphered", A, 0.5, 0.6, 1.2, contact_angle_free_deg=70.0, contact_angle_deg=90.0,
+              height_final_m=4.0e-6)
+    write_run(work, "hategan2004_sphered_642", 0.95 * A, 0.5, 0.6, 1.2, contact_angle_free_deg=80.0,
+              contact_angle_deg=100.0, height_final_m=4.3e-6)
+    write_run(work, "hategan2004_biconcave_642", A, 0.3, 0.3, 1.2, contact_angle_free_deg=60.0,
+              contact_angle_deg=80.0, height_final_m=3.0e-6, energy_residual_relative=0.02)  # fails the balance
+    write_run(work, "cuvelier2007", 0.25e-6, 0.55, 100.0, 20.0, early_window_s=[2, 20])
+    write_run(work, "fig5_reference", A, 0.5, 0.6, 1.2)
+    write_run(work, "fig5_W_x2", 1.2 * A, 0.5, 0.6, 1.2)
+    write_run(work, "fig5_gamma_n_half", 1.1 * A, 0.5, 0.6, 1.2)
+    write_run(work, "fig5_x_max_2.5", 1.001 * A, 0.5, 0.6, 1.2)  # 0.1% wider: below the 0.5%, no
+    write_run(work, "fig5_k_a_2e-3", A, 0.5, 0.61, 1.2)    # 0.8%: no effect
+    # fig5_k_b_x2 left out: its row must say "not run".
+    out = subprocess.run([sys.executable, os.path.join(src, "scripts", "spread_report.py"), work],
+                         capture_output=True, text=True)
+    print(out.stdout, out.stderr)
+    if out.returncode != 0:
+        sys.exit(f"exit status {out.returncode}")
+    expected = {
+        "Hategan sphered, 2562 nodes: early r_cc ∝ t^α": "yes",
+        "Hategan sphered: spreading essentially over by ≈ 1 s": "yes",
+        "Hategan sphered: final contact angle": "yes",
+        "biconcave against sphered (642 nodes)": "yes",
+        "Cuvelier set: early r_cc ∝ t^α": "yes",
+        "Cuvelier set: slower, not over within a second": "yes",
+        "642 against 2562 nodes": "yes",
+        "Figure 5: W × 2 spreads faster and wider": "yes",
+        "Figure 5: γ_n / 2 spreads faster": "yes",
+        "Figure 5: k_b × 2 spreads faster": "–",
+        "Figure 5: x_max 2.5 (from 2.05) spreads wider": "no",
+        "Figure 5: k_a = 2e-3 against 6e-3 N/m (both ≥ 2000 in Table 1's numbers)": "yes",
+        "energy balance (fixed-Δt runs)": "no",
+    }
+    got = {}
+    for line in out.stdout.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) == 4 and cells[0] in expected:
+            got[cells[0]] = cells[3].strip("*")
+    bad = [f"{claim}: expected {want}, got {got.get(claim)}" for claim, want in expected.items()
+           if got.get(claim) != want]
+    for must in ("not run: fig5_k_b_x2", "90.0°", "10 of 12 judged claims hold; 1 not judged"):
+        if must not in out.stdout:
+            bad.append(f"not in the report: {must}")
+    if bad:
+        sys.exit("\n".join(bad))
+    print("spread_report: every verdict as expected")
+
+
+if __name__ == "__main__":
+    main()
