@@ -22,8 +22,12 @@ void initialize_kokkos(int num_threads) {
 std::string kokkos_description() {
   std::ostringstream s;
   s << "Kokkos " << KOKKOS_VERSION / 10000 << '.' << (KOKKOS_VERSION / 100) % 100 << '.'
-    << KOKKOS_VERSION % 100 << ", execution space " << Kokkos::DefaultExecutionSpace::name() << " ("
-    << Kokkos::DefaultExecutionSpace().concurrency() << " threads)";
+    << KOKKOS_VERSION % 100 << ", execution space " << Kokkos::DefaultExecutionSpace::name();
+  if (Kokkos::SpaceAccessibility<Kokkos::DefaultExecutionSpace, Kokkos::HostSpace>::accessible)
+    s << " (" << Kokkos::DefaultExecutionSpace().concurrency() << " threads)";
+  else  // a device: its concurrency counts GPU threads, not what --threads sets
+    s << " (a device; host " << Kokkos::DefaultHostExecutionSpace::name() << " with "
+      << Kokkos::DefaultHostExecutionSpace().concurrency() << " threads)";
   return s.str();
 }
 

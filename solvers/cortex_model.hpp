@@ -264,27 +264,8 @@ class CortexModel {
   void set_flat_bending_rest() {
     if (hinges_) set_hinge_rest_angles(*hinges_, {0.0});
   }
-  // Largest d / d_max over the bonds at the current positions (0 without bonds).
-  double max_bond_extension() const {
-    if (!bonds_) return 0.0;
-    const auto x = mesh_.x;
-    const auto bond = mesh_.bond;
-    const auto rest = bonds_->rest_length;
-    const auto bond_cell = mesh_.bond_cell;
-    const auto table = bond_params_.table();
-    double m = 0;
-    Kokkos::parallel_reduce(
-        "dcm::model::max_bond_extension", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_bonds),
-        KOKKOS_LAMBDA(const int b, double& a) {
-          const double x_max = cell_value(table, bond_cell(b)).x_max;
-          const double e = norm(load3(x, bond(b, 1)) - load3(x, bond(b, 0))) / (x_max * rest(b));
-          if (!(e <= a)) a = e;  // NaN propagates as "not below"
-        },
-        Kokkos::Max<double>(m));
-    return m;
-  }
-
-  // The same per cell (a batch's cells step on their own; a non-finite length counts as infinitely long).
+  // Largest d / d_max over each cell's bonds at the current positions (a batch's cells step on their own; a
+  // non-finite length counts as infinitely long; 0 without bonds).
   std::vector<double> cell_max_bond_extension() const {
     std::vector<double> m(mesh_.n_cells, 0.0);
     if (!bonds_) return m;
@@ -335,6 +316,7 @@ class CortexModel {
                           k_area_local_.table(), k_area_global_.table(), *volume_, k_volume_.table(),
                           *membrane_, force_, overstretched_);
       int bad = -1;
+      space_.fence();  // the scalar deep_copy below does not wait for space_'s kernels in Kokkos 3.x
       Kokkos::deep_copy(bad, overstretched_);
       if (bad >= 0) throw NumericalError(describe_overstretch(bad));
     } else {
@@ -342,6 +324,7 @@ class CortexModel {
         Kokkos::deep_copy(space_, overstretched_, -1);
         add_fene_pow_forces(space_, mesh_, *bonds_, bond_params_.table(), force_, overstretched_);
         int bad = -1;
+        space_.fence();
         Kokkos::deep_copy(bad, overstretched_);
         if (bad >= 0) throw NumericalError(describe_overstretch(bad));
       }

@@ -3,8 +3,10 @@
 // Maugis–Dugdale kernel with W = 0 (Hertz with the paper's geometric contact radius a² = 2Rδ − δ²,
 // kernels/plane_contact.hpp), integrated by velocity Verlet with a rotation update by the exponential map.
 // The rebound heights of icospheres of several resolutions are compared with those of a perfect sphere
-// obeying the same continuum law P(δ) = K a³/R, integrated by RK4 with a tiny step. Writes <out>/summary.json
-// and <out>/series.csv (t_s, then the height of each ball's lowest point).
+// obeying the same continuum law P(δ) = K a³/R, integrated by RK4 with a tiny step. Writes
+// <out>/summary.json, <out>/series.csv (t_s, then the height of each ball's lowest point) and <out>/bounce.h5
+// + .xmf (the balls and the perfect sphere side by side, --frames-per-bounce frames per bounce: the paper's
+// Video S3 in ParaView).
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -17,6 +19,7 @@
 
 #include "apps/common/app_cli.hpp"
 #include "core/h5_output.hpp"
+#include "core/host_mesh.hpp"
 #include "core/json_writer.hpp"
 #include "core/kokkos_compat.hpp"
 #include "core/update_geometry.hpp"
@@ -42,6 +45,7 @@ struct BounceOptions {
   double tilt_deg = 20;   // initial rotation of the mesh about the axis (1, 2, 0)/√5
   double steps_per_contact = 2000;
   double reference_steps_per_contact = 2e5;
+  int frames_per_bounce = 20;  // frames of bounce.h5 per bounce; 0: no bounce.h5 / .xmf
   std::string out_dir = "out/bounce";
   int threads = 0;
   bool quiet = false;
@@ -258,8 +262,16 @@ class RigidBall {
   double reach_ = 0;
 };
 
+// A ball's rigid-body state at time t (for the frames of bounce.h5).
+struct BallState {
+  double t;
+  Real3 c, v, w;
+  Mat3 Q;
+};
+
 struct BallResult {
   int nodes = 0;
+  int subdivisions = 0;
   std::vector<double> heights;       // lowest point (centre height − R) at each apex (m)
   std::vector<double> spin;          // |ω| after each bounce (rad/s)
   std::vector<double> energy_error;  // (E_apex − E_0) / E_0 with E = m g (z − R) + ½ I ω², per bounce
@@ -270,6 +282,7 @@ struct BallResult {
   long long steps = 0;
   double wall_s = 0;
   Trajectory traj;
+  std::vector<BallState> states;  // at the start, at every flight's start and after every contact step
 };
 
 BallResult triangulated_ball(const BounceOptions& o, const PlaneContactParams& prm, int subdivisions,
@@ -279,6 +292,7 @@ BallResult triangulated_ball(const BounceOptions& o, const PlaneContactParams& p
   RigidBall ball(subdivisions, R, prm);
   BallResult res;
   res.nodes = ball.n_nodes();
+  res.subdivisions = subdivisions;
   res.reach = ball.reach();
   res.traj.g = g;
   // Contact is possible only while the centre is below reach; the stepping starts a little above that.
@@ -289,12 +303,15 @@ BallResult triangulated_ball(const BounceOptions& o, const PlaneContactParams& p
   double t = 0;
   const double e0 = mass * g * o.drop_height;
   const Real3 gravity{0, 0, -mass * g};
+  auto record = [&] { res.states.push_back({t, c, v, w, Q}); };
   auto ballistic = [&](double s) {  // exact free flight over time s
+    record();
     c = c + s * v + Real3{0, 0, -0.5 * g * s * s};
     v = v + Real3{0, 0, -g * s};
     Q = orthonormalized(mul(rotation(s * w), Q));
     t += s;
   };
+  record();
   for (int b = 0; b < o.bounces; ++b) {
     if (c.z > z_enter) {
       const double tf = (v.z + std::sqrt(v.z * v.z + 2 * g * (c.z - z_enter))) / g;
@@ -326,6 +343,7 @@ BallResult triangulated_ball(const BounceOptions& o, const PlaneContactParams& p
       res.max_overlap = std::max(res.max_overlap, R - c.z);
       res.traj.t.push_back(t);
       res.traj.h.push_back(c.z - R);
+      record();
       if (!std::isfinite(c.z) || !std::isfinite(norm(w)))
         throw NumericalError("ball with " + std::to_string(res.nodes) +
                              " nodes: non-finite state at t = " + detail::format_real(t) + " s");
@@ -343,8 +361,74 @@ BallResult triangulated_ball(const BounceOptions& o, const PlaneContactParams& p
     res.energy_error.push_back((mass * g * (c.z - R) + 0.5 * mass * norm2(v) + e_rot - e0) / e0);
     res.rotational_fraction = e_rot / e0;
   }
+  record();
   res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return res;
+}
+
+// The ball's centre and orientation at time (from the last recorded state before it, moved by the exact free
+// flight: exact in flight, within one contact step of the integrator during contact).
+void pose_at(const std::vector<BallState>& states, double g, double time, Real3& c, Mat3& Q) {
+  auto it = std::upper_bound(states.begin(), states.end(), time,
+                             [](double value, const BallState& s) { return value < s.t; });
+  const BallState& s = it == states.begin() ? states.front() : *(it - 1);
+  const double h = std::max(0.0, time - s.t);
+  c = s.c + h * s.v + Real3{0, 0, -0.5 * g * h * h};
+  Q = orthonormalized(mul(rotation(h * s.w), s.Q));
+}
+
+// bounce.h5 + .xmf: the perfect sphere (drawn as a 642-node icosphere; it does not rotate) and each
+// triangulated ball side by side along x, 2.5 R apart; /mesh/node_cell says which object a node belongs to
+// (0 the perfect sphere, then the balls in the order of --nodes); frames on a uniform grid over [0, t_end];
+// /series as series.csv.
+void write_frames(const std::string& path, const BounceOptions& o, const SphereResult& ref,
+                  const std::vector<BallResult>& balls, double t_end,
+                  const std::vector<std::vector<std::pair<std::string, double>>>& series) {
+  const double R = o.radius;
+  std::vector<HostMesh> shapes{make_icosphere(3, R)};
+  for (const BallResult& b : balls) shapes.push_back(make_icosphere(b.subdivisions, R));
+  std::vector<double> x0;
+  std::vector<int> tri, cell;
+  for (std::size_t k = 0; k < shapes.size(); ++k) {
+    const int base = static_cast<int>(x0.size() / 3);
+    for (const auto& p : shapes[k].nodes) {
+      x0.insert(x0.end(), {p[0] + 2.5 * R * static_cast<double>(k), p[1], p[2] + R + o.drop_height});
+      cell.push_back(static_cast<int>(k));
+    }
+    for (const auto& t : shapes[k].triangles) tri.insert(tri.end(), {base + t[0], base + t[1], base + t[2]});
+  }
+  H5Output h5(path);
+  h5.write_text("app", "bounce");
+  h5.write_scalar("radius_m", R);
+  h5.write_scalar("drop_height_m", o.drop_height);
+  h5.write_mesh(x0.data(), static_cast<int>(cell.size()), tri.data(), static_cast<int>(tri.size() / 3),
+                cell.data());
+  const int n_frames = o.frames_per_bounce * o.bounces;
+  std::vector<double> x(x0.size());
+  for (int f = 0; f <= n_frames; ++f) {
+    const double time = t_end * f / n_frames;
+    std::size_t i = 0;
+    for (const auto& p : shapes[0].nodes) {  // the perfect sphere: its lowest point's height, no rotation
+      const double z = ref.traj.at(time) + R;
+      x[i++] = p[0];
+      x[i++] = p[1];
+      x[i++] = p[2] + z;
+    }
+    for (std::size_t k = 1; k < shapes.size(); ++k) {
+      Real3 c;
+      Mat3 Q;
+      pose_at(balls[k - 1].states, o.gravity, time, c, Q);
+      for (const auto& p : shapes[k].nodes) {
+        const Real3 r = mul(Q, Real3{p[0], p[1], p[2]});
+        x[i++] = c.x + r.x + 2.5 * R * static_cast<double>(k);
+        x[i++] = c.y + r.y;
+        x[i++] = c.z + r.z;
+      }
+    }
+    h5.write_frame(time, x.data(), {});
+  }
+  for (const auto& row : series) h5.append_series(row);
+  h5.close();
 }
 
 // ---- options ----
@@ -394,6 +478,8 @@ void validate(const BounceOptions& o) {
           "--reference-steps-per-contact", o.reference_steps_per_contact, "1000 .. 1e7");
   require(o.threads >= 0 && o.threads <= 4096, "--threads", o.threads, "0 .. 4096");
   require(o.drop_height > 0 && std::isfinite(o.drop_height), "--drop-height-m", o.drop_height, "0 < H, m");
+  require(o.frames_per_bounce >= 0 && o.frames_per_bounce <= 1000, "--frames-per-bounce", o.frames_per_bounce,
+          "0 .. 1000 (0: no bounce.h5)");
   // The overlap must stay small against R (the law is a small-strain one; a ≤ R/2 keeps the mesh sensible).
   const MdMaterial mat = md_material(o.E, o.nu, 0.0, 20e-9);
   const double mass = 4.0 / 3.0 * kPi * std::pow(o.radius, 3) * o.density;
@@ -411,6 +497,7 @@ void run(const BounceOptions& o) {
   validate(o);
   const std::string out =
       prepare_output_dir(AppOptions{"", {}, o.out_dir, o.threads, o.quiet}, Scene::defaults());
+  remove_earlier_outputs(out, {"series.csv", "series.csv.tmp", "summary.json", "bounce.h5", "bounce.xmf"});
   KokkosSession kokkos(o.threads);
   const double R = o.radius;
   PlaneContactParams prm;
@@ -465,6 +552,7 @@ void run(const BounceOptions& o) {
   // series.csv on a common grid up to the earliest end.
   double t_end = ref.traj.end();
   for (const BallResult& r : balls) t_end = std::min(t_end, r.traj.end());
+  std::vector<std::vector<std::pair<std::string, double>>> series;
   {
     std::ofstream csv(out + "/series.csv.tmp");
     csv << "t_s,reference_m";
@@ -476,9 +564,11 @@ void run(const BounceOptions& o) {
       const double time = t_end * i / n;
       std::snprintf(buf, sizeof buf, "%.9g,%.9g", time, ref.traj.at(time));
       csv << buf;
+      series.push_back({{"t_s", time}, {"reference_m", ref.traj.at(time)}});
       for (const BallResult& r : balls) {
         std::snprintf(buf, sizeof buf, ",%.9g", r.traj.at(time));
         csv << buf;
+        series.back().push_back({"nodes_" + std::to_string(r.nodes) + "_m", r.traj.at(time)});
       }
       csv << '\n';
     }
@@ -540,8 +630,12 @@ void run(const BounceOptions& o) {
       .add("tilt_deg", o.tilt_deg)
       .add("quadrature_points", o.quadrature_points)
       .add("backend", kokkos_description());
+  if (o.frames_per_bounce > 0) write_frames(out + "/bounce.h5", o, ref, balls, t_end, series);
   json.write(out + "/summary.json");
-  if (!o.quiet) std::printf("wrote %s/summary.json and %s/series.csv\n", out.c_str(), out.c_str());
+  if (!o.quiet)
+    std::printf(
+        "wrote %s/summary.json, %s/series.csv%s\n", out.c_str(), out.c_str(),
+        o.frames_per_bounce > 0 ? (" and " + out + "/bounce.h5 (+ .xmf: open in ParaView)").c_str() : "");
 }
 
 }  // namespace
@@ -556,7 +650,9 @@ int main(int argc, char** argv) {
       "kernels/plane_contact.hpp. Its rebound heights (lowest point = centre height - R, at each apex) are "
       "compared with those of a perfect sphere obeying the same continuum law P = K a^3/R, a^2 = 2 R d - "
       "d^2. "
-      "Writes <out>/summary.json and <out>/series.csv. Model: docs/model/bounce.md",
+      "Writes <out>/summary.json, <out>/series.csv and <out>/bounce.h5 + bounce.xmf (the balls and the "
+      "perfect "
+      "sphere side by side, for ParaView). Model: docs/model/bounce.md",
       "bounce");
   app.footer(
       "Examples:\n  bounce\n  bounce --nodes 162,642 --bounces 1 --out /tmp/b --quiet\n"
@@ -588,6 +684,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--reference-steps-per-contact", o.reference_steps_per_contact,
                  "RK4 step of the perfect sphere = Hertz contact time / this, 1000 .. 1e7")
+      ->capture_default_str();
+  app.add_option("--frames-per-bounce", o.frames_per_bounce,
+                 "Frames of bounce.h5/.xmf per bounce, 0 .. 1000 (0: write no bounce.h5)")
       ->capture_default_str();
   app.add_option("--out", o.out_dir, "Output folder")->capture_default_str();
   app.add_option("--threads", o.threads, "Host threads (default: OMP_NUM_THREADS, else all cores)");

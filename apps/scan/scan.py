@@ -390,7 +390,8 @@ def main():
     ap.add_argument("scan_file", metavar="SCAN.toml")
     ap.add_argument("--out", help="output folder (default out/<scan name>)")
     ap.add_argument("--jobs", type=int, default=0,
-                    help="members run at once (per MPI rank; default: the cores, shared among the ranks on a machine)")
+                    help="members run at once (per MPI rank; default: the cores, shared among the ranks on a machine; "
+                         "with a GPU build use --jobs 1 and --chunk N: one process owns the device, its batch fills it)")
     ap.add_argument("--threads", type=int, default=0,
                     help="OpenMP threads per member (default: cores / members run at once)")
     ap.add_argument("--chunk", type=int, default=1,
