@@ -12,11 +12,12 @@ hands them out on request), each rank runs its share with its own pool, and rank
 Outputs in DIR (default out/<scan name>): members/<id>/ (each member's spread output), summary.csv (one row per
 member: id, status, the swept keys, the summary values), scan.h5 (a group per member: its parameters and
 summary as attributes, its series and final frame), scan.json (the members and their resolved --set
-arguments) and r_cc_grid.png (r_cc(t) per swept key). Running the same command again finishes what is
+arguments) and r_cc_grid.png (r_cc(t) per swept key; a latin_hypercube scan also sensitivity.png, the final
+r_cc and contact angle against each swept key). Running the same command again finishes what is
 missing: finished members are kept, interrupted ones continue from their checkpoint.
 Exit codes: 0 all members finished, 2 bad input (nothing written), 3 a member failed numerically, 130 stopped.
 """
-import argparse, csv, itertools, json, math, os, shutil, signal, subprocess, sys, time
+import argparse, csv, itertools, json, math, os, random, shutil, signal, subprocess, sys, time
 
 try:
     import tomllib
@@ -75,6 +76,48 @@ def sweep_values(key, spec):
     raise ScanError(f"sweep.{key} = {spec!r}: give a list of values or a table {{start, stop, num, spacing}}")
 
 
+def lhs_range(key, spec):
+    """(start, stop, spacing) of a latin_hypercube sweep entry: a range without num."""
+    if not isinstance(spec, dict):
+        raise ScanError(f"sweep.{key} = {spec!r}: mode latin_hypercube samples ranges: give {{start, stop, spacing}}")
+    extra = set(spec) - {"start", "stop", "spacing"}
+    if extra:
+        what = "the scan's `samples` sets how many members there are" if extra == {"num"} else "allowed: start, stop, spacing"
+        raise ScanError(f"sweep.{key}: field '{sorted(extra)[0]}' is not used by mode latin_hypercube ({what})")
+    try:
+        start, stop = float(spec["start"]), float(spec["stop"])
+    except (KeyError, TypeError, ValueError):
+        raise ScanError(f"sweep.{key} = {spec}: a range needs numbers start and stop")
+    spacing = spec.get("spacing", "linear")
+    if spacing not in ("linear", "log"):
+        raise ScanError(f"sweep.{key}.spacing = '{spacing}' is not allowed: choose linear or log")
+    if spacing == "log" and not (start > 0 and stop > 0):
+        raise ScanError(f"sweep.{key}: log spacing needs start > 0 and stop > 0 (got {start}, {stop})")
+    if not start < stop:
+        raise ScanError(f"sweep.{key}: start = {start} must be below stop = {stop}")
+    return start, stop, spacing
+
+
+def latin_hypercube(ranges, samples, seed):
+    """samples members; for every key each of the samples equal strata of its range (equal in log for log
+    spacing) holds exactly one member, at a uniformly random place inside it; strata paired at random between
+    keys. Deterministic for a given seed (Python's Mersenne Twister)."""
+    rng = random.Random(seed)
+    columns = {}
+    for key, (start, stop, spacing) in ranges.items():
+        strata = list(range(samples))
+        rng.shuffle(strata)
+        values = []
+        for s_i in strata:
+            u = (s_i + rng.random()) / samples
+            if spacing == "log":
+                values.append(math.exp(math.log(start) + u * (math.log(stop) - math.log(start))))
+            else:
+                values.append(start + u * (stop - start))
+        columns[key] = values
+    return [{k: columns[k][i] for k in ranges} for i in range(samples)]
+
+
 def load_scan(path):
     if tomllib is None:
         raise ScanError("this Python has no tomllib (needs Python >= 3.11)")
@@ -85,7 +128,7 @@ def load_scan(path):
         raise ScanError(f"{path}: no such scan file")
     except tomllib.TOMLDecodeError as e:
         raise ScanError(f"{path}: not valid TOML: {e}")
-    allowed = {"name", "base", "mode", "set", "sweep"}
+    allowed = {"name", "base", "mode", "set", "sweep", "samples", "seed"}
     for k in doc:
         if k not in allowed:
             raise ScanError(f"{path}: unknown key '{k}' (allowed: {', '.join(sorted(allowed))})")
@@ -98,8 +141,21 @@ def load_scan(path):
         if not os.path.isfile(base):
             raise ScanError(f"{path}: base = '{doc['base']}': no such scene file ({base})")
     mode = doc.get("mode", "one_at_a_time")
-    if mode not in ("one_at_a_time", "grid"):
-        raise ScanError(f"{path}: mode = '{mode}' is not allowed: choose one_at_a_time or grid")
+    if mode not in ("one_at_a_time", "grid", "latin_hypercube"):
+        raise ScanError(f"{path}: mode = '{mode}' is not allowed: choose one_at_a_time, grid or latin_hypercube")
+    if mode != "latin_hypercube":
+        for k in ("samples", "seed"):
+            if k in doc:
+                raise ScanError(f"{path}: {k} is used by mode latin_hypercube only (this scan's mode is {mode})")
+    else:
+        samples, seed = doc.get("samples"), doc.get("seed", 1)
+        if samples is None:
+            raise ScanError(f"{path}: mode latin_hypercube needs samples = N (2 .. 10000): the number of members")
+        if not isinstance(samples, int) or isinstance(samples, bool) or not 2 <= samples <= 10000:
+            raise ScanError(f"{path}: samples = {samples!r} is not allowed: mode latin_hypercube needs an integer "
+                            f"samples, 2 .. 10000 (the number of members)")
+        if not isinstance(seed, int) or isinstance(seed, bool) or not 0 <= seed < 2**63:
+            raise ScanError(f"{path}: seed = {seed!r} is not allowed: an integer 0 .. 2^63 - 1")
     fixed = doc.get("set", {})
     sweep = doc.get("sweep", {})
     if not isinstance(fixed, dict) or not isinstance(sweep, dict):
@@ -109,9 +165,14 @@ def load_scan(path):
     for key in list(fixed) + list(sweep):
         if isinstance(fixed.get(key, sweep.get(key)), dict) and key in fixed:
             raise ScanError(f"{path}: set.{key}: write the key in quotes, e.g. \"{key}\" = value")
-    values = {k: sweep_values(k, v) for k, v in sweep.items()}
+    if mode == "latin_hypercube":
+        values = {k: lhs_range(k, v) for k, v in sweep.items()}
+    else:
+        values = {k: sweep_values(k, v) for k, v in sweep.items()}
     members = []  # (label, {key: value}) for the swept keys
-    if mode == "grid":
+    if mode == "latin_hypercube":
+        members = latin_hypercube(values, samples, seed)
+    elif mode == "grid":
         keys = list(values)
         for combo in itertools.product(*(values[k] for k in keys)):
             members.append(dict(zip(keys, combo)))
@@ -209,6 +270,8 @@ def write_h5(scan, out, rows):
 
 
 def plot(scan, out):
+    if os.path.isfile(os.path.join(out, "sensitivity.png")):  # drawn again by a latin_hypercube scan only
+        os.remove(os.path.join(out, "sensitivity.png"))
     plotter = os.path.join(os.path.dirname(os.path.abspath(__file__)), "scan_plot.py")
     if not os.path.isfile(plotter):
         plotter = os.path.join(os.environ.get("DCM_SOURCE_DIR", ""), "apps", "scan", "scan_plot.py")
@@ -503,10 +566,15 @@ def main():
         write_h5(scan, out, rows)
         if not a.no_plot and not stop:
             plot(scan, out)
-        elif os.path.isfile(os.path.join(out, "r_cc_grid.png")):  # an earlier scan's plot: not of these results
-            os.remove(os.path.join(out, "r_cc_grid.png"))
+        else:  # an earlier scan's plots: not of these results
+            for png in ("r_cc_grid.png", "sensitivity.png"):
+                if os.path.isfile(os.path.join(out, png)):
+                    os.remove(os.path.join(out, png))
         if not a.quiet:
-            print(f"{PROG}: wrote {out}/summary.csv, {out}/scan.h5 ({time.time() - t0:.1f} s)", flush=True)
+            wrote = [f for f in ("summary.csv", "scan.h5", "r_cc_grid.png", "sensitivity.png")
+                     if os.path.isfile(os.path.join(out, f))]
+            print(f"{PROG}: wrote {', '.join(os.path.join(out, f) for f in wrote)} ({time.time() - t0:.1f} s)",
+                  flush=True)
         warned = [r["id"] for r in rows if r.get("warnings") not in ("", 0)]
         if warned:
             print(f"{PROG}: warning: {len(warned)} member(s) ended with warnings (their steps did not resolve the "

@@ -1,6 +1,9 @@
 #!/usr/bin/env python3
 """Draws <scan out>/r_cc_grid.png: one panel per swept key (the paper's Figure 5 layout), r_cc(t) of its
-members on log-log axes with a t^(1/2) guide; one_at_a_time scans add the base member in black.
+members on log-log axes with a t^(1/2) guide; one_at_a_time scans add the base member in black. A
+latin_hypercube scan (every member varies every key) colours all members in each panel by that key's value
+(dark: low, yellow: high) and also draws sensitivity.png: the final r_cc and the free-fit contact angle of
+every member against each swept key (from summary.csv).
 usage: scan_plot.py OUT_DIR"""
 import csv, json, math, os, sys
 
@@ -36,12 +39,15 @@ def main():
     for i, key in enumerate(keys):
         ax = axes[i // cols][i % cols]
         members = [m for m in scan["members"] if key in m["swept"]]
+        if scan["mode"] == "latin_hypercube":
+            members.sort(key=lambda m: m["swept"][key])
         cmap = plt.get_cmap("viridis")
         for j, m in enumerate(members):
             t, r = series(out, m["id"])
             if t:
                 label = f"{m['swept'][key]:.3g}" if isinstance(m["swept"][key], float) else str(m["swept"][key])
-                ax.loglog(t, r, color=cmap(j / max(1, len(members) - 1)), lw=1.3, label=label)
+                ax.loglog(t, r, color=cmap(j / max(1, len(members) - 1)), lw=1.3,
+                          label=label if len(members) <= 8 else None)
         if base:
             t, r = series(out, base["id"])
             if t:
@@ -54,7 +60,7 @@ def main():
         all_r = [v for m in members for v in series(out, m["id"])[1]]
         if all_r:  # the first touch-down (r_cc of nanometres) would squash the curves
             ax.set_ylim(bottom=max(min(all_r), 0.03 * max(all_r)), top=1.3 * max(all_r))
-        ax.set_title(key, fontsize=9)
+        ax.set_title(key + (" (colour: low to high)" if len(members) > 8 else ""), fontsize=9)
         ax.set_xlabel("t (s)")
         ax.set_ylabel("r_cc (µm)")
         ax.legend(fontsize=7)
@@ -63,6 +69,30 @@ def main():
     fig.suptitle(f"scan {scan['name']} ({scan['mode']})", fontsize=10)
     fig.tight_layout()
     fig.savefig(os.path.join(out, "r_cc_grid.png"), dpi=110)
+    if scan["mode"] == "latin_hypercube":
+        sensitivity(scan, out)
+
+
+def sensitivity(scan, out):
+    """sensitivity.png: final r_cc (top row) and free-fit contact angle (bottom row) against each swept key."""
+    with open(os.path.join(out, "summary.csv")) as f:
+        rows = [r for r in csv.DictReader(f) if r["status"] == "done"]
+    keys = scan["sweep_keys"]
+    fig, axes = plt.subplots(2, len(keys), figsize=(3.8 * len(keys), 6.0), squeeze=False)
+    for i, key in enumerate(keys):
+        pts = [(float(r[key]), float(r["r_cc_final_m"]) * 1e6, float(r["contact_angle_free_deg"] or "nan"))
+               for r in rows if r[key] and r["r_cc_final_m"]]
+        for row, (what, unit) in enumerate((("final r_cc", "µm"), ("contact angle (free fit)", "°"))):
+            ax = axes[row][i]
+            ax.plot([p[0] for p in pts], [p[1 + row] for p in pts], "o", ms=4)
+            values = [p[0] for p in pts if p[0] > 0]
+            if values and min(values) > 0 and max(values) / min(values) > 10:
+                ax.set_xscale("log")
+            ax.set_xlabel(key, fontsize=8)
+            ax.set_ylabel(f"{what} ({unit})", fontsize=8)
+    fig.suptitle(f"scan {scan['name']}: {len(rows)} members (latin hypercube)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "sensitivity.png"), dpi=110)
 
 
 if __name__ == "__main__":
