@@ -184,7 +184,10 @@ def load_scan(path):
     out = []
     for i, swept in enumerate(members):
         sets = [f"{k}={fmt(v)}" for k, v in fixed.items()] + [f"{k}={fmt(v)}" for k, v in swept.items()]
-        label = ", ".join(f"{k}={fmt(v)}" for k, v in swept.items()) or "base"
+        if mode == "latin_hypercube":  # random values: 4 digits in the label (the --set arguments keep them all)
+            label = ", ".join(f"{k}={v:.4g}" for k, v in swept.items())
+        else:
+            label = ", ".join(f"{k}={fmt(v)}" for k, v in swept.items()) or "base"
         out.append({"id": f"m{i:03d}", "label": label, "swept": swept, "sets": sets})
     return {"name": name, "base": base, "mode": mode, "sweep_keys": list(values), "members": out}
 

@@ -86,8 +86,9 @@ def sensitivity(scan, out):
             ax = axes[row][i]
             ax.plot([p[0] for p in pts], [p[1 + row] for p in pts], "o", ms=4)
             values = [p[0] for p in pts if p[0] > 0]
-            if values and min(values) > 0 and max(values) / min(values) > 10:
+            if values and min(values) > 0 and max(values) / min(values) >= 3:
                 ax.set_xscale("log")
+            ax.tick_params(labelsize=7)
             ax.set_xlabel(key, fontsize=8)
             ax.set_ylabel(f"{what} ({unit})", fontsize=8)
     fig.suptitle(f"scan {scan['name']}: {len(rows)} members (latin hypercube)", fontsize=10)
