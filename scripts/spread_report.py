@@ -73,6 +73,11 @@ def max_relative_difference(a, b, t_from, t_to):
     return worst
 
 
+def um(value):
+    """Metres as micrometres; None for a missing or non-numeric value."""
+    return value * 1e6 if isinstance(value, (int, float)) and not isinstance(value, bool) else None
+
+
 def fmt(value, spec, unit=""):
     if value is None or (isinstance(value, float) and not math.isfinite(value)):
         return "–"
@@ -104,17 +109,20 @@ def report(folder):
     def in_band(value, low, high):
         return None if value is None else low <= value <= high
 
+    def exponent_row(claim, name):  # the early exponent of a run against the paper's 0.5 ± 0.1
+        target = "α = 0.5 ± 0.1"
+        if not missing(claim, target, name):
+            s = runs[name][0]
+            a, w = s.get("early_exponent"), s.get("early_window_s") or [None, None]
+            row(claim, target, f"α = {fmt(a, '.3f')} over {fmt(w[0], 'g')}–{fmt(w[1], 'g')} s", in_band(a, 0.4, 0.6))
+
     # Hategan set, sphered, 2562 nodes.
     name = "hategan2004_sphered"
-    claim, target = "Hategan sphered, 2562 nodes: early r_cc ∝ t^α", "α = 0.5 ± 0.1"
-    if not missing(claim, target, name):
-        s = runs[name][0]
-        a, w = s.get("early_exponent"), s.get("early_window_s") or [None, None]
-        row(claim, target, f"α = {fmt(a, '.3f')} over {fmt(w[0], 'g')}–{fmt(w[1], 'g')} s", in_band(a, 0.4, 0.6))
+    exponent_row("Hategan sphered, 2562 nodes: early r_cc ∝ t^α", name)
     claim, target = "Hategan sphered: spreading essentially over by ≈ 1 s", "99% of the final r_cc by 1 s"
     if not missing(claim, target, name):
         t99 = time_to_fraction(runs[name][1], 0.99)
-        row(claim, target, f"99% at {fmt(t99, '.2f', ' s')} (final r_cc {fmt(runs[name][0].get('r_cc_final_m', 0) * 1e6, '.3f', ' µm')})",
+        row(claim, target, f"99% at {fmt(t99, '.2f', ' s')} (final r_cc {fmt(um(runs[name][0].get('r_cc_final_m')), '.3f', ' µm')})",
             None if t99 is None else t99 <= 1.0)
     claim, target = "Hategan sphered: final contact angle", "65° ± 10° (free fit)"
     if not missing(claim, target, name):
@@ -130,23 +138,19 @@ def report(folder):
         hb, hs = b.get("height_final_m"), s.get("height_final_m")
         ab, as_ = b.get("contact_angle_free_deg"), s.get("contact_angle_free_deg")
         ok = None if None in (hb, hs, ab, as_) else (hb < hs and ab < as_)
-        row(claim, target, f"height {fmt(hb * 1e6 if hb else None, '.2f')} against {fmt(hs * 1e6 if hs else None, '.2f', ' µm')}; "
+        row(claim, target, f"height {fmt(um(hb), '.2f')} against {fmt(um(hs), '.2f', ' µm')}; "
             f"free-fit angle {fmt(ab, '.1f', '°')} against {fmt(as_, '.1f', '°')}", ok)
 
     # Cuvelier set.
     name = "cuvelier2007"
-    claim, target = "Cuvelier set: early r_cc ∝ t^α", "α = 0.5 ± 0.1"
-    if not missing(claim, target, name):
-        s = runs[name][0]
-        a, w = s.get("early_exponent"), s.get("early_window_s") or [None, None]
-        row(claim, target, f"α = {fmt(a, '.3f')} over {fmt(w[0], 'g')}–{fmt(w[1], 'g')} s", in_band(a, 0.4, 0.6))
+    exponent_row("Cuvelier set: early r_cc ∝ t^α", name)
     claim, target = "Cuvelier set: slower, not over within a second", "r_cc(1 s) below half the final r_cc"
     if not missing(claim, target, name):
         series = runs[name][1]
         r1, rf = r_at(series, 1.0), (series[1][-1] if series[1] else None)
         ok = None if r1 is None or not rf else r1 < 0.5 * rf
-        row(claim, target, f"r_cc {fmt(r1 * 1e6 if r1 is not None else None, '.3f')} µm at 1 s, "
-            f"{fmt(rf * 1e6 if rf else None, '.3f')} µm at {fmt(series[0][-1] if series[0] else None, 'g')} s", ok)
+        row(claim, target, f"r_cc {fmt(um(r1), '.3f')} µm at 1 s, "
+            f"{fmt(um(rf), '.3f')} µm at {fmt(series[0][-1] if series[0] else None, 'g')} s", ok)
 
     # Mesh: 642 against 2562 nodes.
     claim, target = "642 against 2562 nodes", "early r_cc within 15% (0.01–0.1 s), final r_cc 2% or more apart"
@@ -157,7 +161,7 @@ def report(folder):
         final = None if not rc or not rf else abs(rc - rf) / rf
         ok = None if early is None or final is None else (early <= 0.15 and final >= 0.02)
         row(claim, target, f"early within {fmt(early * 100 if early is not None else None, '.1f', '%')}; final "
-            f"{fmt(rc * 1e6 if rc else None, '.3f')} against {fmt(rf * 1e6 if rf else None, '.3f', ' µm')} "
+            f"{fmt(um(rc), '.3f')} against {fmt(um(rf), '.3f', ' µm')} "
             f"({fmt(final * 100 if final is not None else None, '.1f', '%')})", ok)
 
     # The paper's Figure 5 directions, each against the reference run.
@@ -208,7 +212,7 @@ def report(folder):
         s = runs["hategan2004_contact_line"][0]
         extra.append(f"hategan2004_contact_line ({s.get('nodes')} nodes, dcm's contact-line law): free-fit angle "
                      f"{fmt(s.get('contact_angle_free_deg'), '.1f', '°')}, α = {fmt(s.get('early_exponent'), '.3f')}, "
-                     f"final r_cc {fmt(s.get('r_cc_final_m', 0) * 1e6, '.3f', ' µm')}")
+                     f"final r_cc {fmt(um(s.get('r_cc_final_m')), '.3f', ' µm')}")
     if runs["cuvelier2007_derjaguin"] is not None:
         s = runs["cuvelier2007_derjaguin"][0]
         extra.append(f"cuvelier2007_derjaguin (dcm's contact-line law): α = {fmt(s.get('early_exponent'), '.3f')}")
