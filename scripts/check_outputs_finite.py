@@ -5,12 +5,12 @@ usage: check_outputs_finite.py DIR [DIR ...]
 
 Walks every DIR for the files the apps write (*.csv, *.json, *.h5) and reports each value that is
 nan or inf: CSV fields (any spelling: nan, -nan, NaN, inf, -Infinity, ...), JSON numbers (Python's
-reader accepts NaN/Infinity, which other readers refuse), and floating-point HDF5 datasets (needs h5py;
-without it the HDF5 files are counted as skipped). An app must report numerical trouble by name (step,
+reader accepts NaN/Infinity, which other readers refuse, and reads 1e999 as inf), and floating-point HDF5
+datasets and attributes (needs h5py; without it the HDF5 files are counted as skipped). An app must report numerical trouble by name (step,
 term, node), never write it as a number (DEVELOPERS.md). An empty field is not a number and passes.
 
-Prints one line per problem (file, place, value) and a count; exit status 0 if none, 1 otherwise,
-2 on bad usage.
+Prints one line per problem (file, place, value) and a count; exit status 0 if none, 1 if any or if the
+folders hold no such file at all (the tests that write them did not run), 2 on bad usage.
 """
 import csv
 import json
@@ -40,10 +40,16 @@ def check_json(path, problems):
         found.append(name)
         return None
 
+    def number(text):  # a literal too large for a double (1e999) reads as inf
+        value = float(text)
+        if not math.isfinite(value):
+            found.append(text)
+        return value
+
     with open(path, errors="replace") as f:
         text = f.read()
     try:
-        json.loads(text, parse_constant=constant)
+        json.loads(text, parse_constant=constant, parse_float=number)
     except ValueError as error:
         problems.append(f"{path}: not valid JSON ({error})")
         return
@@ -52,7 +58,14 @@ def check_json(path, problems):
 
 
 def check_h5(path, problems, h5py, numpy):
+    def attributes(name, obj):  # of every group and dataset, the root included
+        for key, value in obj.attrs.items():
+            values = numpy.asarray(value)
+            if values.dtype.kind in "fc" and not numpy.isfinite(values).all():
+                problems.append(f"{path}: /{name} attribute {key}: {value}")
+
     def visit(name, obj):
+        attributes(name, obj)
         if not isinstance(obj, h5py.Dataset) or obj.dtype.kind not in "fc":
             return
         data = numpy.asarray(obj[()])
@@ -61,12 +74,10 @@ def check_h5(path, problems, h5py, numpy):
             first = numpy.argwhere(bad)[0] if data.ndim else ()
             problems.append(f"{path}: /{name}: {int(bad.sum())} non-finite of {data.size}, "
                             f"first at index {tuple(int(i) for i in first)}")
-        for key, value in obj.attrs.items():
-            if isinstance(value, float) and not math.isfinite(value):
-                problems.append(f"{path}: /{name} attribute {key}: {value}")
 
     try:
         with h5py.File(path, "r") as f:
+            attributes("", f)
             f.visititems(visit)
     except OSError as error:
         problems.append(f"{path}: cannot be read as HDF5 ({error})")
@@ -105,8 +116,13 @@ def main(argv):
                         check_h5(path, problems, h5py, numpy)
     for line in problems:
         print(line)
-    summary = ", ".join(f"{n} {kind}" for kind, n in counts.items() if n)
-    print(f"{summary or 'no output files'} checked, {len(problems)} non-finite values")
+    checked = ", ".join(f"{n} {kind}" for kind, n in counts.items() if n and kind != "h5 skipped")
+    skipped = f" ({counts['h5 skipped']} HDF5 files skipped: no h5py)" if counts["h5 skipped"] else ""
+    if not checked:  # nothing to check is not a pass: the app tests that write the outputs did not run
+        print(f"check_outputs_finite: no CSV, JSON or HDF5 file under {' '.join(argv[1:])}{skipped}: run the app "
+              f"tests first (ctest -R '^app[.]|^validation[.]')")
+        return 1
+    print(f"{checked} checked{skipped}, {len(problems)} non-finite values")
     return 1 if problems else 0
 
 

@@ -7,7 +7,8 @@ Reads the runs that scripts/spread_validation.sh writes into DIR (one spread out
 summary.json and series.csv) and prints, for each claim of the paper that issue 5 checks, the measured value
 and whether it holds: the Hategan set's early exponent, end of spreading and contact angle; biconcave against
 sphered; the Cuvelier set; 642 against 2562 nodes; the directions of the paper's Figure 5; the energy balance.
-A run that is missing or failed is reported as such; the other rows are still made. Exit status 0 whether or
+A claim whose run has no summary.json (not run, or failed) or stopped before its end (Ctrl-C, --max-steps)
+is not judged and says so; the other rows are still made. Exit status 0 whether or
 not the claims hold (the table says), 2 if DIR does not exist.
 
 The thresholds a row applies are printed in its "target" column; where the paper gives a band (0.5 ± 0.1,
@@ -22,20 +23,27 @@ import sys
 
 
 def load(folder, name):
-    """(summary dict, (t list, r list)) of a run, or None if it has no summary.json."""
+    """(summary dict, (t list, r list)) of a finished run; None if it has no summary.json (not run, or failed);
+    the string "stopped at t = ..." if it was interrupted or stopped by --max-steps before its end."""
     path = os.path.join(folder, name)
     try:
         with open(os.path.join(path, "summary.json")) as f:
             summary = json.load(f)
     except (OSError, ValueError):
         return None
+    if summary.get("interrupted") or summary.get("stopped_at_max_steps"):
+        return f"stopped at t = {summary.get('t_end_s', '?')} s before its end"
     t, r = [], []
     try:
         with open(os.path.join(path, "series.csv"), newline="") as f:
             for row in csv.DictReader(f):
-                t.append(float(row["t_s"]))
-                r.append(float(row["r_cc_m"]))
-    except (OSError, KeyError, ValueError):
+                try:
+                    ti, ri = float(row["t_s"]), float(row["r_cc_m"])
+                except (KeyError, TypeError, ValueError):
+                    continue  # a row that does not parse is left out whole, so t and r stay paired
+                t.append(ti)
+                r.append(ri)
+    except OSError:
         pass
     return summary, (t, r)
 
@@ -78,10 +86,18 @@ def um(value):
     return value * 1e6 if isinstance(value, (int, float)) and not isinstance(value, bool) else None
 
 
+def pct(value):
+    """A ratio as per cent; None stays None."""
+    return None if value is None else 100 * value
+
+
 def fmt(value, spec, unit=""):
     if value is None or (isinstance(value, float) and not math.isfinite(value)):
         return "–"
-    return f"{value + 0.0:{spec}}{unit}".replace("-0.0", "0.0").replace("+-", "-")
+    text = f"{value:{spec}}"
+    if float(text) == 0:  # rounds to zero: no sign ("-0.0", "+0.0" would read as a direction)
+        text = f"{0.0:{spec.replace('+', '')}}"
+    return text + unit
 
 
 def verdict(ok):
@@ -97,14 +113,19 @@ def report(folder):
         runs[name] = load(folder, name)
     rows = []
 
+    def finished(name):
+        return isinstance(runs[name], tuple)
+
     def row(claim, target, measured, ok):
         rows.append((claim, target, measured, verdict(ok)))
 
     def missing(claim, target, *needed):
         absent = [n for n in needed if runs[n] is None]
-        if absent:
-            row(claim, target, "not run: " + ", ".join(absent), None)
-        return bool(absent)
+        stopped = [f"{n} {runs[n]}" for n in needed if isinstance(runs[n], str)]
+        if absent or stopped:
+            row(claim, target, "; ".join((["not run or failed: " + ", ".join(absent)] if absent else []) + stopped),
+                None)
+        return bool(absent or stopped)
 
     def in_band(value, low, high):
         return None if value is None else low <= value <= high
@@ -160,9 +181,9 @@ def report(folder):
         rc, rf = coarse[0].get("r_cc_final_m"), fine[0].get("r_cc_final_m")
         final = None if not rc or not rf else abs(rc - rf) / rf
         ok = None if early is None or final is None else (early <= 0.15 and final >= 0.02)
-        row(claim, target, f"early within {fmt(early * 100 if early is not None else None, '.1f', '%')}; final "
+        row(claim, target, f"early within {fmt(pct(early), '.1f', '%')}; final "
             f"{fmt(um(rc), '.3f')} against {fmt(um(rf), '.3f', ' µm')} "
-            f"({fmt(final * 100 if final is not None else None, '.1f', '%')})", ok)
+            f"({fmt(pct(final), '.1f', '%')})", ok)
 
     # The paper's Figure 5 directions, each against the reference run.
     def direction(run, what, faster, wider, no_effect=False):
@@ -177,8 +198,8 @@ def report(folder):
         f0, f1 = ref[0].get("r_cc_final_m"), var[0].get("r_cc_final_m")
         early = None if not r0 or r1 is None else r1 / r0 - 1
         final = None if not f0 or f1 is None else f1 / f0 - 1
-        measured = (f"r_cc at 0.01 s {fmt(early * 100 if early is not None else None, '+.1f', '%')}, "
-                    f"final {fmt(final * 100 if final is not None else None, '+.2f', '%')}")
+        measured = (f"r_cc at 0.01 s {fmt(pct(early), '+.1f', '%')}, "
+                    f"final {fmt(pct(final), '+.2f', '%')}")
         if no_effect:
             ok = None if final is None else abs(final) <= 0.02
         else:
@@ -197,7 +218,7 @@ def report(folder):
     # Energy balance of the fixed-step runs.
     claim, target = "energy balance (fixed-Δt runs)", "residual below 1% of the powers"
     fixed = [n for n in ("hategan2004_sphered", "hategan2004_sphered_642", "hategan2004_biconcave_642")
-             if runs[n] is not None]
+             if finished(n)]
     if not fixed:
         row(claim, target, "not run", None)
     else:
@@ -208,12 +229,12 @@ def report(folder):
 
     # dcm's contact-line law (not the paper's model; informational).
     extra = []
-    if runs["hategan2004_contact_line"] is not None:
+    if finished("hategan2004_contact_line"):
         s = runs["hategan2004_contact_line"][0]
         extra.append(f"hategan2004_contact_line ({s.get('nodes')} nodes, dcm's contact-line law): free-fit angle "
                      f"{fmt(s.get('contact_angle_free_deg'), '.1f', '°')}, α = {fmt(s.get('early_exponent'), '.3f')}, "
                      f"final r_cc {fmt(um(s.get('r_cc_final_m')), '.3f', ' µm')}")
-    if runs["cuvelier2007_derjaguin"] is not None:
+    if finished("cuvelier2007_derjaguin"):
         s = runs["cuvelier2007_derjaguin"][0]
         extra.append(f"cuvelier2007_derjaguin (dcm's contact-line law): α = {fmt(s.get('early_exponent'), '.3f')}")
 
@@ -224,12 +245,12 @@ def report(folder):
     lines += [f"| {c} | {t} | {m} | {v} |" for c, t, m, v in rows]
     if extra:
         lines += [""] + [f"- {e}" for e in extra]
-    warned = [n for n, run in runs.items() if run is not None and run[0].get("warnings")]
+    warned = [n for n in runs if finished(n) and runs[n][0].get("warnings")]
     if warned:
         lines += ["", "Runs that ended with warnings (see their summary.json): " + ", ".join(warned)]
     held = sum(1 for r in rows if r[3] == "**yes**")
     judged = sum(1 for r in rows if r[3] != "–")
-    lines += ["", f"{held} of {judged} judged claims hold; {len(rows) - judged} not judged (runs missing)."]
+    lines += ["", f"{held} of {judged} judged claims hold; {len(rows) - judged} not judged (runs missing or stopped)."]
     return "\n".join(lines)
 
 

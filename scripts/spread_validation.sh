@@ -2,8 +2,9 @@
 # The spreading runs behind docs/VALIDATION.md ("Spreading"): the paper scenes, the 642-node Hategan case
 # for the mesh comparison, one run per direction of the paper's Figure 5 and two with the contact-line law, in
 # two queues of one thread each (2 cores). Output: out/validation/<run>/ (each a spread output folder) and
-# out/validation/report.md (scripts/spread_report.py: each claim of the paper, measured, and whether it holds).
-# Takes about 25 minutes on 2 cores (session 12: 21.6 min before the two contact-line runs were added).
+# out/validation/report.md (scripts/spread_report.py: each claim of the paper, measured, and whether it holds;
+# with QUEUE 1 or 2 the other queue's folders, possibly of older code, are judged too).
+# Takes about 20 minutes on 2 cores (session 16: 20.4 min).
 # (The full paper scenes: build/bin/spread scenes/<scene>.toml.)
 #   bash scripts/spread_validation.sh [QUEUE]    # QUEUE = 1, 2 or both (default)
 set -euo pipefail
@@ -47,5 +48,5 @@ case "${1:-both}" in
   *) echo "usage: $0 [1|2|both]" >&2; exit 2 ;;
 esac
 # The paper's claims against these runs (docs/VALIDATION.md "Status at a glance" holds the same rows).
-python3 scripts/spread_report.py "$out" > "$out/report.md"
+python3 scripts/spread_report.py "$out" > "$out/report.md.tmp" && mv "$out/report.md.tmp" "$out/report.md"
 echo "wrote $out/report.md: $(tail -n 1 "$out/report.md")"

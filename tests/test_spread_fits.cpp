@@ -96,4 +96,7 @@ TEST(SpreadFits, ExponentOfAPowerLawInsideTheWindow) {
   EXPECT_EQ(used, 0);
   EXPECT_TRUE(std::isnan(dcm::spread_fits::fit_exponent(t, r, 0.085, 0.11, used)));  // two rows
   EXPECT_EQ(used, 2);
+  const std::vector<double> same_t(4, 0.05), some_r{1e-6, 2e-6, 3e-6, 4e-6};
+  EXPECT_TRUE(std::isnan(dcm::spread_fits::fit_exponent(same_t, some_r, 0.01, 0.1, used)));  // one time
+  EXPECT_EQ(used, 4);
 }

@@ -478,8 +478,10 @@ void validate(const BounceOptions& o) {
           "--reference-steps-per-contact", o.reference_steps_per_contact, "1000 .. 1e7");
   require(o.threads >= 0 && o.threads <= 4096, "--threads", o.threads, "0 .. 4096");
   require(o.drop_height > 0 && std::isfinite(o.drop_height), "--drop-height-m", o.drop_height, "0 < H, m");
-  require(o.frames_per_bounce >= 0 && o.frames_per_bounce <= 1000, "--frames-per-bounce", o.frames_per_bounce,
-          "0 .. 1000 (0: no bounce.h5)");
+  require(o.frames_per_bounce >= 0 && o.frames_per_bounce * o.bounces <= 1000, "--frames-per-bounce",
+          o.frames_per_bounce,
+          "0 .. " + std::to_string(1000 / o.bounces) + " with --bounces " + std::to_string(o.bounces) +
+              ": at most 1000 frames in bounce.h5 (0: none)");
   // The overlap must stay small against R (the law is a small-strain one; a ≤ R/2 keeps the mesh sensible).
   const MdMaterial mat = md_material(o.E, o.nu, 0.0, 20e-9);
   const double mass = 4.0 / 3.0 * kPi * std::pow(o.radius, 3) * o.density;
@@ -686,7 +688,7 @@ int main(int argc, char** argv) {
                  "RK4 step of the perfect sphere = Hertz contact time / this, 1000 .. 1e7")
       ->capture_default_str();
   app.add_option("--frames-per-bounce", o.frames_per_bounce,
-                 "Frames of bounce.h5/.xmf per bounce, 0 .. 1000 (0: write no bounce.h5)")
+                 "Frames of bounce.h5/.xmf per bounce, 0 .. 1000 / bounces (0: write no bounce.h5)")
       ->capture_default_str();
   app.add_option("--out", o.out_dir, "Output folder")->capture_default_str();
   app.add_option("--threads", o.threads, "Host threads (default: OMP_NUM_THREADS, else all cores)");

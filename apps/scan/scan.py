@@ -41,6 +41,16 @@ def fmt(v):
     return str(v)
 
 
+def range_number(key, spec, field):
+    """sweep.<key>.<field> of a range as a finite float; ScanError naming it otherwise."""
+    if field not in spec:
+        raise ScanError(f"sweep.{key} = {spec}: a range needs {field} (a finite number)")
+    value = spec[field]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ScanError(f"sweep.{key}.{field} = {value!r} is not allowed: a finite number")
+    return float(value)
+
+
 def sweep_values(key, spec):
     if isinstance(spec, list):
         if not spec:
@@ -56,10 +66,10 @@ def sweep_values(key, spec):
         extra = set(spec) - allowed
         if extra:
             raise ScanError(f"sweep.{key}: unknown field '{sorted(extra)[0]}' (allowed: start, stop, num, spacing)")
-        try:
-            start, stop, num = float(spec["start"]), float(spec["stop"]), int(spec["num"])
-        except (KeyError, TypeError, ValueError):
-            raise ScanError(f"sweep.{key} = {spec}: a range needs numbers start, stop and an integer num")
+        start, stop = range_number(key, spec, "start"), range_number(key, spec, "stop")
+        num = spec.get("num")
+        if isinstance(num, bool) or not isinstance(num, int):
+            raise ScanError(f"sweep.{key} = {spec}: a range needs an integer num (1 .. 1000)")
         spacing = spec.get("spacing", "linear")
         if not 1 <= num <= 1000:
             raise ScanError(f"sweep.{key}.num = {num} is out of range: allowed 1 .. 1000")
@@ -84,10 +94,7 @@ def lhs_range(key, spec):
     if extra:
         what = "the scan's `samples` sets how many members there are" if extra == {"num"} else "allowed: start, stop, spacing"
         raise ScanError(f"sweep.{key}: field '{sorted(extra)[0]}' is not used by mode latin_hypercube ({what})")
-    try:
-        start, stop = float(spec["start"]), float(spec["stop"])
-    except (KeyError, TypeError, ValueError):
-        raise ScanError(f"sweep.{key} = {spec}: a range needs numbers start and stop")
+    start, stop = range_number(key, spec, "start"), range_number(key, spec, "stop")
     spacing = spec.get("spacing", "linear")
     if spacing not in ("linear", "log"):
         raise ScanError(f"sweep.{key}.spacing = '{spacing}' is not allowed: choose linear or log")
@@ -272,9 +279,15 @@ def write_h5(scan, out, rows):
     os.replace(tmp, os.path.join(out, "scan.h5"))
 
 
+def remove_plots(out, names=("r_cc_grid.png", "sensitivity.png")):
+    """Removes an earlier scan's plots from out (they are not of the results being written)."""
+    for png in names:
+        if os.path.isfile(os.path.join(out, png)):
+            os.remove(os.path.join(out, png))
+
+
 def plot(scan, out):
-    if os.path.isfile(os.path.join(out, "sensitivity.png")):  # drawn again by a latin_hypercube scan only
-        os.remove(os.path.join(out, "sensitivity.png"))
+    remove_plots(out, ("sensitivity.png",))  # drawn again by a latin_hypercube scan only
     plotter = os.path.join(os.path.dirname(os.path.abspath(__file__)), "scan_plot.py")
     if not os.path.isfile(plotter):
         plotter = os.path.join(os.environ.get("DCM_SOURCE_DIR", ""), "apps", "scan", "scan_plot.py")
@@ -451,7 +464,8 @@ def member_files(out, ids):
 
 def main():
     ap = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0],
-                                 epilog="Scan files: scans/quick.toml, scans/figure5.toml; format in docs/SCANS.md. "
+                                 epilog="Scan files: scans/quick.toml, scans/figure5.toml, scans/sensitivity.toml; modes "
+                                        "one_at_a_time, grid and latin_hypercube; format in docs/SCANS.md. "
                                         "Over several machines: mpirun -np P scan SCAN.toml (docs/SCANS.md).")
     ap.add_argument("scan_file", metavar="SCAN.toml")
     ap.add_argument("--out", help="output folder (default out/<scan name>)")
@@ -463,7 +477,7 @@ def main():
     ap.add_argument("--chunk", type=int, default=1,
                     help="members run as one batch (spread --batch; default 1: each member its own process)")
     ap.add_argument("--dry-run", action="store_true", help="list the members and their --set arguments, run nothing")
-    ap.add_argument("--no-plot", action="store_true", help="do not draw r_cc_grid.png")
+    ap.add_argument("--no-plot", action="store_true", help="do not draw r_cc_grid.png (nor sensitivity.png)")
     ap.add_argument("--quiet", action="store_true", help="print only errors")
     ap.add_argument("--spread", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "spread"),
                     help=argparse.SUPPRESS)
@@ -569,10 +583,8 @@ def main():
         write_h5(scan, out, rows)
         if not a.no_plot and not stop:
             plot(scan, out)
-        else:  # an earlier scan's plots: not of these results
-            for png in ("r_cc_grid.png", "sensitivity.png"):
-                if os.path.isfile(os.path.join(out, png)):
-                    os.remove(os.path.join(out, png))
+        else:
+            remove_plots(out)
         if not a.quiet:
             wrote = [f for f in ("summary.csv", "scan.h5", "r_cc_grid.png", "sensitivity.png")
                      if os.path.isfile(os.path.join(out, f))]

@@ -49,7 +49,7 @@ inline CapFit fit_cap(const std::vector<double>& x, double plane_z, bool free_me
 }
 
 // Least-squares slope of log r against log t over the rows with from ≤ t ≤ to and r > 0; NaN with fewer than
-// three such rows (used says how many there were).
+// three such rows or all of them at one time (used says how many there were).
 inline double fit_exponent(const std::vector<double>& t, const std::vector<double>& r, double from, double to,
                            int& used) {
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
@@ -63,8 +63,9 @@ inline double fit_exponent(const std::vector<double>& t, const std::vector<doubl
     sxy += lx * ly;
     ++used;
   }
-  if (used < 3) return NAN;
-  return (used * sxy - sx * sy) / (used * sxx - sx * sx);
+  const double spread = used * sxx - sx * sx;  // 0 (up to rounding) when every row has the same t
+  if (used < 3 || !(spread > 1e-12 * used * sxx)) return NAN;
+  return (used * sxy - sx * sy) / spread;
 }
 
 }  // namespace dcm::spread_fits
