@@ -48,6 +48,35 @@ def load(folder, name):
     return summary, (t, r)
 
 
+def cap_deviation(folder, name):
+    """(rms, max) distance of the free membrane's nodes (above 10% of the height) from the sphere fitted to
+    them, relative to its radius, and the radius, from the last frame of the run's spread.h5; a string saying
+    why not (no h5py, no spread.h5)."""
+    try:
+        os.environ.setdefault("HDF5_USE_FILE_LOCKING", "FALSE")
+        import h5py
+        import numpy
+    except ImportError:
+        return "needs h5py and numpy"
+    path = os.path.join(folder, name, "spread.h5")
+    try:
+        with h5py.File(path, "r") as f:
+            last = sorted(f["frames"].keys())[-1]
+            x = f["frames"][last]["x"][()]
+    except (OSError, KeyError, IndexError):
+        return "no frames in spread.h5"
+    z = x[:, 2]
+    free = x[z > z.min() + 0.1 * (z.max() - z.min())]
+    if len(free) < 4:
+        return "too few free nodes"
+    a = numpy.c_[2 * free, numpy.ones(len(free))]
+    sol = numpy.linalg.lstsq(a, (free ** 2).sum(axis=1), rcond=None)[0]
+    centre = sol[:3]
+    radius = math.sqrt(sol[3] + centre @ centre)
+    d = numpy.linalg.norm(free - centre, axis=1) - radius
+    return float(numpy.sqrt((d ** 2).mean()) / radius), float(abs(d).max() / radius), radius
+
+
 def r_at(series, time):
     """r_cc at time (linear interpolation of the series), None outside it."""
     t, r = series
@@ -151,6 +180,15 @@ def report(folder):
         free, paper = s.get("contact_angle_free_deg"), s.get("contact_angle_deg")
         row(claim, target, f"free fit {fmt(free, '.1f', '°')}, top-95% fit {fmt(paper, '.1f', '°')}",
             in_band(free, 55.0, 75.0))
+
+    claim, target = "Hategan sphered: the final shape is a spherical cap", "free membrane within 1% (rms) of a sphere"
+    if not missing(claim, target, name):
+        dev = cap_deviation(folder, name)
+        if isinstance(dev, str):
+            row(claim, target, dev, None)
+        else:
+            row(claim, target, f"rms {fmt(pct(dev[0]), '.2f', '%')}, largest {fmt(pct(dev[1]), '.2f', '%')} of "
+                f"R = {fmt(um(dev[2]), '.3f', ' µm')} (nodes above 10% of the height, last frame)", dev[0] <= 0.01)
 
     # Biconcave against sphered.
     claim, target = "biconcave against sphered (642 nodes)", "lower final height and contact angle"

@@ -48,5 +48,6 @@ case "${1:-both}" in
   *) echo "usage: $0 [1|2|both]" >&2; exit 2 ;;
 esac
 # The paper's claims against these runs (docs/VALIDATION.md "Status at a glance" holds the same rows).
-python3 scripts/spread_report.py "$out" > "$out/report.md.tmp" && mv "$out/report.md.tmp" "$out/report.md"
+py=$(command -v /usr/bin/python3 || command -v python3)  # Debian's, with h5py and numpy (scripts/deps.sh)
+"$py" scripts/spread_report.py "$out" > "$out/report.md.tmp" && mv "$out/report.md.tmp" "$out/report.md"
 echo "wrote $out/report.md: $(tail -n 1 "$out/report.md")"
