@@ -408,8 +408,8 @@ void write_frames(const std::string& path, const BounceOptions& o, const SphereR
   for (int f = 0; f <= n_frames; ++f) {
     const double time = t_end * f / n_frames;
     std::size_t i = 0;
-    for (const auto& p : shapes[0].nodes) {  // the perfect sphere: its lowest point's height, no rotation
-      const double z = ref.traj.at(time) + R;
+    const double z = ref.traj.at(time) + R;  // the perfect sphere: its lowest point's height, no rotation
+    for (const auto& p : shapes[0].nodes) {
       x[i++] = p[0];
       x[i++] = p[1];
       x[i++] = p[2] + z;
@@ -554,23 +554,24 @@ void run(const BounceOptions& o) {
   // series.csv on a common grid up to the earliest end.
   double t_end = ref.traj.end();
   for (const BallResult& r : balls) t_end = std::min(t_end, r.traj.end());
+  // The rows once, for series.csv and bounce.h5's /series.
   std::vector<std::vector<std::pair<std::string, double>>> series;
+  const int n_rows = 2000;
+  for (int i = 0; i <= n_rows; ++i) {
+    const double time = t_end * i / n_rows;
+    series.push_back({{"t_s", time}, {"reference_m", ref.traj.at(time)}});
+    for (const BallResult& r : balls)
+      series.back().push_back({"nodes_" + std::to_string(r.nodes) + "_m", r.traj.at(time)});
+  }
   {
     std::ofstream csv(out + "/series.csv.tmp");
-    csv << "t_s,reference_m";
-    for (const BallResult& r : balls) csv << ",nodes_" << r.nodes << "_m";
+    for (std::size_t k = 0; k < series.front().size(); ++k) csv << (k ? "," : "") << series.front()[k].first;
     csv << '\n';
     char buf[64];
-    const int n = 2000;
-    for (int i = 0; i <= n; ++i) {
-      const double time = t_end * i / n;
-      std::snprintf(buf, sizeof buf, "%.9g,%.9g", time, ref.traj.at(time));
-      csv << buf;
-      series.push_back({{"t_s", time}, {"reference_m", ref.traj.at(time)}});
-      for (const BallResult& r : balls) {
-        std::snprintf(buf, sizeof buf, ",%.9g", r.traj.at(time));
+    for (const auto& row : series) {
+      for (std::size_t k = 0; k < row.size(); ++k) {
+        std::snprintf(buf, sizeof buf, "%s%.9g", k ? "," : "", row[k].second);
         csv << buf;
-        series.back().push_back({"nodes_" + std::to_string(r.nodes) + "_m", r.traj.at(time)});
       }
       csv << '\n';
     }
