@@ -26,6 +26,7 @@
 // per-term kernels (to rounding), on meshes with several cells and per-cell constants.
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 #include "core/cell_params.hpp"
 #include "core/geometry.hpp"
@@ -85,17 +86,19 @@ void fill_membrane_slots(const MeshBuffers<MemorySpace>& mesh,
 // per node and no pass needs atomics.
 template <class MemorySpace>
 struct MembraneScratch {
+  // Per cell and call, the constants of the edge pass: k_b, k_s, x_max^2, k_s / (1 - 1/x_max^2), k_a,
+  // k_d (A_c - A_c*)/A_c* (N/m) and -k_v (V_c - V_c*)/(3 V_c*) (Pa), eqs. 24, 26-29; one row per cell.
+  static constexpr int kCellConstants = 8;
   Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace> slot_force;  // per (node, hinge entry) (N)
   Kokkos::View<int* [4], Kokkos::LayoutRight, MemorySpace> edge_slot;      // slot of (edge, hinge node)
   Kokkos::View<int* [2], Kokkos::LayoutRight, MemorySpace> edge_tri;       // triangles of the wings k, l
-  // Per cell and call: k_d (A_c - A_c*)/A_c* (N/m) and -k_v (V_c - V_c*)/(3 V_c*) (Pa), eqs. 28 and 29.
-  Kokkos::View<double* [2], Kokkos::LayoutRight, MemorySpace> cell_factor;
+  Kokkos::View<double* [kCellConstants], Kokkos::LayoutRight, MemorySpace> cell_constants;
   MembraneScratch() = default;
   explicit MembraneScratch(const MeshBuffers<MemorySpace>& mesh)
       : slot_force("dcm::membrane::slot_force", 4 * mesh.n_hinges),
         edge_slot("dcm::membrane::edge_slot", mesh.n_hinges),
         edge_tri("dcm::membrane::edge_tri", mesh.n_hinges),
-        cell_factor("dcm::membrane::cell_factor", mesh.n_cells) {
+        cell_constants("dcm::membrane::cell_constants", mesh.n_cells) {
     fill_membrane_slots(mesh, edge_slot, edge_tri);
     const auto tris = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), edge_tri);
     for (int e = 0; e < mesh.n_hinges; ++e)
@@ -117,6 +120,166 @@ bool bonds_match_hinges(const MeshBuffers<MemorySpace>& mesh) {
   return true;
 }
 
+namespace membrane_detail {
+
+// The edge pass on W consecutive edges per work item (docs/model/membrane_pass.md). Raw pointers with
+// compile-time strides: the lanes' loads and stores are most of the pass, and a View's runtime strides
+// cost an integer multiply per access.
+template <int W>
+struct EdgePass {
+  int n;                         // edges (n >= W)
+  const double* x;               // positions [node][3]
+  const int* hinge;              // [edge][4] (i, j, k, l)
+  const int* slot;               // [edge][4] the slots of (i, j, k, l)
+  const int* tri2;               // [edge][2] the wings' triangles
+  const int* edge_cell;          // [edge]
+  const double* rest_length;     // [edge] d*
+  const double* rest_trig;       // [edge][2] (cos theta*, sin theta*)
+  const double* rest_area;       // [triangle] A_t*
+  const double* cell_constants;  // [cell][K]
+  double* out;                   // [slot][3]
+  double* grad;                  // [edge][4][3] dtheta/dx per role
+  double* moment;                // [edge]
+  double* cos_delta;             // [edge]
+  int* overstretched;
+  static constexpr int K = 8;
+
+  KOKKOS_INLINE_FUNCTION void operator()(const int batch) const {
+    const int start = batch * W;
+    // The last batch overlaps the one before it (same lanes, same bits) and stores only its new edges.
+    const int base = start + W <= n ? start : n - W, first = start - base;
+    double p[4][3][W];
+    for (int l = 0; l < W; ++l)
+      for (int v = 0; v < 4; ++v) {
+        const double* xv = x + 3 * hinge[4 * (base + l) + v];
+        for (int d = 0; d < 3; ++d) p[v][d][l] = xv[d];
+      }
+    double dr[W], cr[W], sr[W], a0[2][W];
+    for (int l = 0; l < W; ++l) {
+      dr[l] = rest_length[base + l];
+      cr[l] = rest_trig[2 * (base + l)];
+      sr[l] = rest_trig[2 * (base + l) + 1];
+    }
+    for (int l = 0; l < W; ++l)
+      for (int side = 0; side < 2; ++side) a0[side][l] = rest_area[tri2[2 * (base + l) + side]];
+    // The cells' constants (MembraneScratch::cell_constants): one row for the batch where its edges share a
+    // cell.
+    double kb[W], ks[W], xm2[W], kcf[W], ka[W], global[W], vol[W];
+    const int c_first = edge_cell[base], c_last = edge_cell[base + W - 1];
+    for (int l = 0; l < W; ++l) {
+      const double* k = cell_constants + K * (c_first == c_last ? c_first : edge_cell[base + l]);
+      kb[l] = k[0];
+      ks[l] = k[1];
+      xm2[l] = k[2];
+      kcf[l] = k[3];
+      ka[l] = k[4];
+      global[l] = k[5];
+      vol[l] = k[6];
+    }
+    double g[4][3][W], m[W], cd[W], o[4][3][W];
+    int bond_bad[W];
+    for (int l = 0; l < W; ++l) {
+      const double ex = p[1][0][l] - p[0][0][l], ey = p[1][1][l] - p[0][1][l],
+                   ez = p[1][2][l] - p[0][2][l];  // e = x_j - x_i
+      const double ax = p[2][0][l] - p[0][0][l], ay = p[2][1][l] - p[0][1][l],
+                   az = p[2][2][l] - p[0][2][l];  // x_k - x_i
+      const double bx = p[3][0][l] - p[1][0][l], by = p[3][1][l] - p[1][1][l],
+                   bz = p[3][2][l] - p[1][2][l];  // x_l - x_j
+      // n1 = e x a = 2 A_1 n_1 of triangle (i, j, k); n2 = b x e = 2 A_2 n_2 of triangle (j, i, l)
+      const double n1x = ey * az - ez * ay, n1y = ez * ax - ex * az, n1z = ex * ay - ey * ax;
+      const double n2x = by * ez - bz * ey, n2y = bz * ex - bx * ez, n2z = bx * ey - by * ex;
+      const double e2 = ex * ex + ey * ey + ez * ez;
+      const double n1_2 = n1x * n1x + n1y * n1y + n1z * n1z, n2_2 = n2x * n2x + n2y * n2y + n2z * n2z;
+      const double d_rest = dr[l], d_max2 = xm2[l] * d_rest * d_rest;
+      // Bond (eqs. 21-24): usable for 0 < d < d_max; hinge: for non-degenerate triangles.
+      const bool bond_ok = (e2 > 0) & (e2 < d_max2);  // false for NaN too (& keeps the lanes branch-free)
+      const bool hinge_ok = (e2 > 0) & (n1_2 > 0) & (n2_2 > 0);
+      const double e2s = e2 > 0 ? e2 : 1.0, gap = bond_ok ? d_max2 - e2 : 1.0;
+      const double n1s = n1_2 > 0 ? n1_2 : 1.0, n2s = n2_2 > 0 ? n2_2 : 1.0;
+      const double len = math::sqrt(e2s), r1 = math::sqrt(n1s), r2 = math::sqrt(n2s);  // |e|, |n1|, |n2|
+      // One division for the four reciprocals 1/|e|, 1/gap, 1/|n1|, 1/|n2|.
+      const double q = 1.0 / (len * gap * r1 * r2);
+      const double inv_len = q * gap * r1 * r2, inv_gap = q * len * r1 * r2;
+      const double inv_r1 = q * len * gap * r2, inv_r2 = q * len * gap * r1;
+      const double inv_n1 = inv_r1 * inv_r1, inv_n2 = inv_r2 * inv_r2;  // 1/|n1|^2, 1/|n2|^2
+      // U'(d)/d = k_s d_max^2 / (d_max^2 - d^2) - k_c / d^3, k_c = k_s d*^3 / (1 - 1/x_max^2) (eq. 24)
+      const double k_c = kcf[l] * d_rest * d_rest * d_rest;
+      const double u = bond_ok ? ks[l] * d_max2 * inv_gap - k_c * inv_len * inv_len * inv_len : 0.0;
+      bond_bad[l] = bond_ok ? 0 : 1;
+      // Hinge (eq. 26), kernels/bending.hpp's hinge_trig_gradient() with these reciprocals.
+      const double inv = inv_r1 * inv_r2 * inv_len;  // 1 / (|e| |n1| |n2|)
+      const double c = hinge_ok ? len * (n1x * n2x + n1y * n2y + n1z * n2z) * inv : 1.0;
+      const double s =
+          hinge_ok
+              ? ((n1y * n2z - n1z * n2y) * ex + (n1z * n2x - n1x * n2z) * ey + (n1x * n2y - n1y * n2x) * ez) *
+                    inv
+              : 0.0;
+      const double gk = hinge_ok ? -len * inv_n1 : 0.0, gl = hinge_ok ? -len * inv_n2 : 0.0;
+      const double inv_e2 = inv_len * inv_len;
+      const double ak = (ax * ex + ay * ey + az * ez) * inv_e2;
+      const double al = (bx * ex + by * ey + bz * ez) * inv_e2 + 1.0;  // (x_l - x_i) . e / |e|^2
+      const double n1v[3] = {n1x, n1y, n1z}, n2v[3] = {n2x, n2y, n2z}, ev[3] = {ex, ey, ez};
+      const double mm = -kb[l] * (s * cr[l] - c * sr[l]);  // -M = -k_b sin(theta - theta*), eq. 26
+      m[l] = mm;
+      cd[l] = c * cr[l] + s * sr[l];
+      // The wings' area and volume forces (each triangle's corner opposite this edge; the triangle's
+      // other corners get theirs from its other two edges), kernels/area_constraints.hpp and
+      // volume_constraint.hpp with A = |n|/2 and unit normal n/|n|:
+      //   F = -(1/2) [k_a (A - A*)/A* + k_d (A_c - A_c*)/A_c*] n/|n| x (x_c - x_b)   (eqs. 27, 28)
+      //       - k_v (V_c - V_c*)/V_c* (A/3) n/|n|                                      (eq. 29)
+      // with x_c - x_b = e for the wing k of (i, j, k) and -e for the wing l of (j, i, l). A degenerate
+      // triangle (n = 0) gets no force, as in the per-term kernels.
+      const double h1 = -0.5 * (ka[l] * (0.5 * r1 - a0[0][l]) / a0[0][l] + global[l]) * inv_r1;
+      const double h2 = 0.5 * (ka[l] * (0.5 * r2 - a0[1][l]) / a0[1][l] + global[l]) * inv_r2;
+      const double v2 = 0.5 * vol[l];
+      const double w1[3] = {n1y * ez - n1z * ey, n1z * ex - n1x * ez, n1x * ey - n1y * ex};  // n1 x e
+      const double w2[3] = {n2y * ez - n2z * ey, n2z * ex - n2x * ez, n2x * ey - n2y * ex};  // n2 x e
+      for (int d = 0; d < 3; ++d) {
+        const double g2 = gk * n1v[d], g3 = gl * n2v[d];
+        const double g0 = (ak - 1) * g2 + (al - 1) * g3, g1 = -ak * g2 - al * g3;
+        g[0][d][l] = g0;
+        g[1][d][l] = g1;
+        g[2][d][l] = g2;
+        g[3][d][l] = g3;
+        o[0][d][l] = mm * g0 + u * ev[d];  // the bond's force on i: U'(d)/d (x_j - x_i); on j the opposite
+        o[1][d][l] = mm * g1 - u * ev[d];
+        o[2][d][l] = mm * g2 + (h1 * w1[d] + v2 * n1v[d]);
+        o[3][d][l] = mm * g3 + (h2 * w2[d] + v2 * n2v[d]);
+      }
+    }
+    int any_bad = 0;
+    for (int l = 0; l < W; ++l) any_bad |= bond_bad[l];
+    if (any_bad)
+      for (int l = first; l < W; ++l)
+        if (bond_bad[l]) Kokkos::atomic_compare_exchange(overstretched, -1, base + l);
+    if (first == 0) {  // whole batches: fixed-length runs (vector stores)
+      for (int l = 0; l < W; ++l) {
+        moment[base + l] = m[l];
+        cos_delta[base + l] = cd[l];
+      }
+      for (int v = 0; v < 4; ++v)
+        for (int d = 0; d < 3; ++d)
+          for (int l = 0; l < W; ++l) grad[12 * (base + l) + 3 * v + d] = g[v][d][l];
+    } else if (W > 1) {
+      for (int l = first; l < W; ++l) {
+        moment[base + l] = m[l];
+        cos_delta[base + l] = cd[l];
+        for (int v = 0; v < 4; ++v)
+          for (int d = 0; d < 3; ++d) grad[12 * (base + l) + 3 * v + d] = g[v][d][l];
+      }
+    }
+    for (int l = first; l < W; ++l)
+      for (int v = 0; v < 4; ++v) {
+        double* o_v = out + 3 * slot[4 * (base + l) + v];
+        o_v[0] = o[v][0][l];
+        o_v[1] = o[v][1][l];
+        o_v[2] = o[v][2][l];
+      }
+  }
+};
+
+}  // namespace membrane_detail
+
 // force += bonds + bending + area + volume forces. Needs update_geometry() on the current mesh.x (the cells'
 // area and volume; the triangles' areas and normals are recomputed from the positions). Requires
 // bonds_match_hinges(mesh). A zero constant costs its arithmetic but no extra pass. overstretched: set to -1
@@ -130,149 +293,63 @@ void add_membrane_forces(const ExecutionSpace& space, const MeshBuffers<MemorySp
                          const MembraneScratch<MemorySpace>& scratch,
                          const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& force,
                          const Kokkos::View<int, MemorySpace>& overstretched) {
-  constexpr int W = MembraneLanes<ExecutionSpace>::value;
-  const auto x = mesh.x;
+  constexpr int K = MembraneScratch<MemorySpace>::kCellConstants;
+  static_assert(K == membrane_detail::EdgePass<1>::K, "one row layout");
   const int n = mesh.n_hinges;
-  const auto hinge = mesh.hinge;
-  const auto edge_cell = mesh.hinge_cell;
-  const auto rest_length = bond_rest.rest_length;
-  const auto rest_trig = hinge_rest.rest_trig;
-  const auto grad = hinge_rest.hinge_grad;
-  const auto moment = hinge_rest.hinge_moment;
-  const auto cos_delta = hinge_rest.hinge_cos_delta;
-  const auto slot = scratch.edge_slot;
-  const auto edge_tri = scratch.edge_tri;
-  const auto out = scratch.slot_force;
-  const auto rest_area = area_rest.tri_area;
-  const auto factor = scratch.cell_factor;
-  {  // the cells' global area and volume factors, once per cell
+  {  // Per cell, once per call: the edge pass's constants, the global area and volume factors included.
     const auto cell_area = geo.cell_area;
     const auto cell_volume = geo.cell_volume;
     const auto rest_cell_area = area_rest.cell_area;
     const auto rest_volume = volume_rest.cell_volume;
+    const auto row = scratch.cell_constants;
     Kokkos::parallel_for(
         "dcm::membrane::cells", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_cells),
         KOKKOS_LAMBDA(const int c) {
-          factor(c, 0) =
-              cell_value(k_d, c) * (cell_area(c) - rest_cell_area(c)) / rest_cell_area(c);  // eq. 28
-          factor(c, 1) =
+          const FenePowParams bp = cell_value(bond_params, c);
+          const double xm2 = bp.x_max * bp.x_max;
+          row(c, 0) = cell_value(k_b, c);
+          row(c, 1) = bp.k_s;
+          row(c, 2) = xm2;
+          row(c, 3) = bp.k_s / (1 - 1 / xm2);  // k_c / d*^3 (eq. 24)
+          row(c, 4) = cell_value(k_a, c);
+          row(c, 5) = cell_value(k_d, c) * (cell_area(c) - rest_cell_area(c)) / rest_cell_area(c);  // eq. 28
+          row(c, 6) =
               -cell_value(k_v, c) * (cell_volume(c) - rest_volume(c)) / rest_volume(c) / 3.0;  // eq. 29
+          row(c, 7) = 0;
         });
   }
-  // 1. Edge pass.
-  Kokkos::parallel_for(
-      "dcm::membrane::edges", Kokkos::RangePolicy<ExecutionSpace>(space, 0, (n + W - 1) / W),
-      KOKKOS_LAMBDA(const int batch) {
-        double p[4][3][W], d_rest[W], cr[W], sr[W], kb[W], ks[W], xm2[W];
-        double a0[2][W], ka[W], global[W], vol[W];  // the wings' triangles: eqs. 27-29
-        for (int l = 0; l < W; ++l) {
-          const int e = batch * W + l < n ? batch * W + l : n - 1;
-          const int c = edge_cell(e);
-          for (int v = 0; v < 4; ++v)
-            for (int d = 0; d < 3; ++d) p[v][d][l] = x(hinge(e, v), d);
-          d_rest[l] = rest_length(e);
-          cr[l] = rest_trig(e, 0);
-          sr[l] = rest_trig(e, 1);
-          kb[l] = cell_value(k_b, c);
-          const FenePowParams bp = cell_value(bond_params, c);
-          ks[l] = bp.k_s;
-          xm2[l] = bp.x_max * bp.x_max;
-          a0[0][l] = rest_area(edge_tri(e, 0));
-          a0[1][l] = rest_area(edge_tri(e, 1));
-          ka[l] = cell_value(k_a, c);
-          global[l] = factor(c, 0);
-          vol[l] = factor(c, 1);
-        }
-        double g[4][3][W], m[W], cd[W], fb[3][W], fw[2][3][W];
-        int bond_bad[W];
-        for (int l = 0; l < W; ++l) {
-          const double ex = p[1][0][l] - p[0][0][l], ey = p[1][1][l] - p[0][1][l],
-                       ez = p[1][2][l] - p[0][2][l];  // e = x_j - x_i
-          const double ax = p[2][0][l] - p[0][0][l], ay = p[2][1][l] - p[0][1][l],
-                       az = p[2][2][l] - p[0][2][l];  // x_k - x_i
-          const double bx = p[3][0][l] - p[1][0][l], by = p[3][1][l] - p[1][1][l],
-                       bz = p[3][2][l] - p[1][2][l];  // x_l - x_j
-          // n1 = e x a = 2 A_1 n_1 of triangle (i, j, k); n2 = b x e = 2 A_2 n_2 of triangle (j, i, l)
-          const double n1x = ey * az - ez * ay, n1y = ez * ax - ex * az, n1z = ex * ay - ey * ax;
-          const double n2x = by * ez - bz * ey, n2y = bz * ex - bx * ez, n2z = bx * ey - by * ex;
-          const double e2 = ex * ex + ey * ey + ez * ez;
-          const double n1_2 = n1x * n1x + n1y * n1y + n1z * n1z, n2_2 = n2x * n2x + n2y * n2y + n2z * n2z;
-          const double dr = d_rest[l], d_max2 = xm2[l] * dr * dr;
-          // Bond (eqs. 21-24): usable for 0 < d < d_max; hinge: for non-degenerate triangles.
-          const bool bond_ok = (e2 > 0) & (e2 < d_max2);  // false for NaN too (& keeps the lanes branch-free)
-          const bool hinge_ok = (e2 > 0) & (n1_2 > 0) & (n2_2 > 0);
-          const double e2s = e2 > 0 ? e2 : 1.0, gap = bond_ok ? d_max2 - e2 : 1.0;
-          const double n1s = n1_2 > 0 ? n1_2 : 1.0, n2s = n2_2 > 0 ? n2_2 : 1.0;
-          const double len = math::sqrt(e2s), r1 = math::sqrt(n1s), r2 = math::sqrt(n2s);  // |e|, |n1|, |n2|
-          // One division for the four reciprocals 1/|e|, 1/gap, 1/|n1|, 1/|n2|.
-          const double q = 1.0 / (len * gap * r1 * r2);
-          const double inv_len = q * gap * r1 * r2, inv_gap = q * len * r1 * r2;
-          const double inv_r1 = q * len * gap * r2, inv_r2 = q * len * gap * r1;
-          const double inv_n1 = inv_r1 * inv_r1, inv_n2 = inv_r2 * inv_r2;  // 1/|n1|^2, 1/|n2|^2
-          // U'(d)/d = k_s d_max^2 / (d_max^2 - d^2) - k_c / d^3, k_c = k_s d*^3 / (1 - 1/x_max^2) (eq. 24)
-          const double k_c = ks[l] * dr * dr * dr / (1 - 1 / xm2[l]);
-          const double u = bond_ok ? ks[l] * d_max2 * inv_gap - k_c * inv_len * inv_len * inv_len : 0.0;
-          fb[0][l] = u * ex;  // the bond's force on i: U'(d)/d (x_j - x_i); on j the opposite
-          fb[1][l] = u * ey;
-          fb[2][l] = u * ez;
-          bond_bad[l] = bond_ok ? 0 : 1;
-          // Hinge (eq. 26), kernels/bending.hpp's hinge_trig_gradient() with these reciprocals.
-          const double inv = inv_r1 * inv_r2 * inv_len;  // 1 / (|e| |n1| |n2|)
-          const double c = hinge_ok ? len * (n1x * n2x + n1y * n2y + n1z * n2z) * inv : 1.0;
-          const double s = hinge_ok ? ((n1y * n2z - n1z * n2y) * ex + (n1z * n2x - n1x * n2z) * ey +
-                                       (n1x * n2y - n1y * n2x) * ez) *
-                                          inv
-                                    : 0.0;
-          const double gk = hinge_ok ? -len * inv_n1 : 0.0, gl = hinge_ok ? -len * inv_n2 : 0.0;
-          const double inv_e2 = inv_len * inv_len;
-          const double ak = (ax * ex + ay * ey + az * ez) * inv_e2;
-          const double al = (bx * ex + by * ey + bz * ez) * inv_e2 + 1.0;  // (x_l - x_i) . e / |e|^2
-          g[2][0][l] = gk * n1x;
-          g[2][1][l] = gk * n1y;
-          g[2][2][l] = gk * n1z;
-          g[3][0][l] = gl * n2x;
-          g[3][1][l] = gl * n2y;
-          g[3][2][l] = gl * n2z;
-          for (int d = 0; d < 3; ++d) {
-            g[0][d][l] = (ak - 1) * g[2][d][l] + (al - 1) * g[3][d][l];
-            g[1][d][l] = -ak * g[2][d][l] - al * g[3][d][l];
-          }
-          m[l] = -kb[l] * (s * cr[l] - c * sr[l]);  // -M = -k_b sin(theta - theta*), eq. 26
-          cd[l] = c * cr[l] + s * sr[l];
-          // The wings' area and volume forces (each triangle's corner opposite this edge; the triangle's
-          // other corners get theirs from its other two edges), kernels/area_constraints.hpp and
-          // volume_constraint.hpp with A = |n|/2 and unit normal n/|n|:
-          //   F = -(1/2) [k_a (A - A*)/A* + k_d (A_c - A_c*)/A_c*] n/|n| x (x_c - x_b)   (eqs. 27, 28)
-          //       - k_v (V_c - V_c*)/V_c* (A/3) n/|n|                                      (eq. 29)
-          // with x_c - x_b = e for the wing k of (i, j, k) and -e for the wing l of (j, i, l). A degenerate
-          // triangle (n = 0) gets no force, as in the per-term kernels.
-          const double h1 = -0.5 * (ka[l] * (0.5 * r1 - a0[0][l]) / a0[0][l] + global[l]) * inv_r1;
-          const double h2 = 0.5 * (ka[l] * (0.5 * r2 - a0[1][l]) / a0[1][l] + global[l]) * inv_r2;
-          const double v2 = 0.5 * vol[l];
-          fw[0][0][l] = h1 * (n1y * ez - n1z * ey) + v2 * n1x;
-          fw[0][1][l] = h1 * (n1z * ex - n1x * ez) + v2 * n1y;
-          fw[0][2][l] = h1 * (n1x * ey - n1y * ex) + v2 * n1z;
-          fw[1][0][l] = h2 * (n2y * ez - n2z * ey) + v2 * n2x;
-          fw[1][1][l] = h2 * (n2z * ex - n2x * ez) + v2 * n2y;
-          fw[1][2][l] = h2 * (n2x * ey - n2y * ex) + v2 * n2z;
-        }
-        for (int l = 0; l < W; ++l) {
-          const int e = batch * W + l;
-          if (e >= n) continue;
-          if (bond_bad[l]) Kokkos::atomic_compare_exchange(&overstretched(), -1, e);
-          moment(e) = m[l];
-          cos_delta(e) = cd[l];
-          for (int v = 0; v < 4; ++v)
-            for (int d = 0; d < 3; ++d) grad(e, v, d) = g[v][d][l];
-          const int s0 = slot(e, 0), s1 = slot(e, 1), s2 = slot(e, 2), s3 = slot(e, 3);
-          for (int d = 0; d < 3; ++d) {
-            out(s0, d) = m[l] * g[0][d][l] + fb[d][l];
-            out(s1, d) = m[l] * g[1][d][l] - fb[d][l];
-            out(s2, d) = m[l] * g[2][d][l] + fw[0][d][l];
-            out(s3, d) = m[l] * g[3][d][l] + fw[1][d][l];
-          }
-        }
-      });
+  // 1. Edge pass. It indexes the Views' data with their unpadded LayoutRight strides.
+  const auto grad = hinge_rest.hinge_grad;
+  if (mesh.x.stride_0() != 3 || mesh.hinge.stride_0() != 4 || scratch.edge_slot.stride_0() != 4 ||
+      scratch.edge_tri.stride_0() != 2 || hinge_rest.rest_trig.stride_0() != 2 || grad.stride_0() != 12 ||
+      scratch.slot_force.stride_0() != 3)
+    throw std::logic_error("add_membrane_forces: a View is padded");
+  auto run = [&](auto pass) {
+    constexpr int W = decltype(pass)::value;
+    membrane_detail::EdgePass<W> f;
+    f.n = n;
+    f.x = mesh.x.data();
+    f.hinge = mesh.hinge.data();
+    f.slot = scratch.edge_slot.data();
+    f.tri2 = scratch.edge_tri.data();
+    f.edge_cell = mesh.hinge_cell.data();
+    f.rest_length = bond_rest.rest_length.data();
+    f.rest_trig = hinge_rest.rest_trig.data();
+    f.rest_area = area_rest.tri_area.data();
+    f.cell_constants = scratch.cell_constants.data();
+    f.out = scratch.slot_force.data();
+    f.grad = grad.data();
+    f.moment = hinge_rest.hinge_moment.data();
+    f.cos_delta = hinge_rest.hinge_cos_delta.data();
+    f.overstretched = overstretched.data();
+    Kokkos::parallel_for("dcm::membrane::edges",
+                         Kokkos::RangePolicy<ExecutionSpace>(space, 0, (n + W - 1) / W), f);
+  };
+  constexpr int W = MembraneLanes<ExecutionSpace>::value;
+  if (n >= W)
+    run(std::integral_constant<int, W>{});
+  else
+    run(std::integral_constant<int, 1>{});
   // 2. Node gather: the node's slots, contiguous.
   {
     const auto hinge_offsets = mesh.node_hinge_offsets;
