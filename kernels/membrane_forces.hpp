@@ -19,8 +19,11 @@
 //    and no scattered reads (the scattered accesses are the pass's stores).
 //
 // Pass 1 works on MembraneLanes consecutive edges per work item, loaded into small local arrays and
-// computed in straight-line loops over the lanes, which the host compiler turns into SIMD instructions (8
-// doubles per AVX-512 instruction); on a GPU a work item is one edge (MembraneLanes = 1).
+// computed in straight-line loops over the lanes, which the host compiler turns into SIMD instructions;
+// on a GPU a work item is one edge (MembraneLanes = 1). The constants of each cell (k_b, k_s, x_max,
+// k_a and the global area and volume factors) are gathered into one row per cell before the pass; a
+// batch whose edges share a cell reads one row. Where the edge count is not a multiple of the lanes, the
+// last batch overlaps the one before it and stores only its own edges.
 //
 // Expectations (tests/test_membrane_forces.cpp): the same forces, hinge scratch and overstretch flag as the
 // per-term kernels (to rounding), on meshes with several cells and per-cell constants.
