@@ -25,6 +25,9 @@ except ImportError:  # Python < 3.11
     tomllib = None
 
 PROG = "scan"
+# Whether spread was built for a GPU (a Kokkos with CUDA, HIP or SYCL): apps/scan/CMakeLists.txt sets it when
+# it copies this file into the build. The environment variable DCM_SCAN_DEVICE_BUILD (0 or 1) overrides it.
+DEVICE_BUILD = False  # set by the build
 SUMMARY_KEYS = ["r_cc_final_m", "contact_angle_deg", "contact_angle_free_deg", "early_exponent",
                 "height_final_m", "steps", "wall_s", "mean_cg_iterations"]
 
@@ -471,7 +474,8 @@ def main():
     ap.add_argument("--out", help="output folder (default out/<scan name>)")
     ap.add_argument("--jobs", type=int, default=0,
                     help="members run at once (per MPI rank; default: the cores, shared among the ranks on a machine; "
-                         "with a GPU build use --jobs 1 and --chunk N: one process owns the device, its batch fills it)")
+                         "1 with a GPU build, where one process owns the device: add --chunk N so that its batch "
+                         "fills it)")
     ap.add_argument("--threads", type=int, default=0,
                     help="OpenMP threads per member (default: cores / members run at once)")
     ap.add_argument("--chunk", type=int, default=1,
@@ -510,7 +514,8 @@ def main():
 
     cores = os.cpu_count() or 1
     per_rank_cores = max(1, cores // ranks_on_this_machine(comm))
-    jobs = a.jobs or per_rank_cores
+    device = os.environ.get("DCM_SCAN_DEVICE_BUILD", "1" if DEVICE_BUILD else "0") == "1"
+    jobs = a.jobs or (1 if device else per_rank_cores)
     if rank > 0 and os.environ.get("DCM_SCAN_PRIVATE_DISKS") == "1":  # tests: as if each rank had its own disk
         out = f"{out}.rank{rank}"
     shared = os.path.isfile(os.path.join(out, "scan.json"))  # rank 0 wrote it before the broadcast
@@ -540,6 +545,9 @@ def main():
             where = f"; {size} MPI ranks" if comm else ""
             print(f"{PROG}: {scan['name']}: {len(members)} members, {len(members) - n_todo} already done; {jobs} at a "
                   f"time, {threads} thread(s) each{where} -> {out}", flush=True)
+            if device and not a.jobs and a.chunk == 1 and n_todo > 1:
+                print(f"{PROG}: GPU build: one process at a time owns the device; --chunk N runs N members in it as "
+                      f"one batch (spread --batch)", flush=True)
         done_ranks, remote = set(), {}
         handed = {"stop": False}
 
