@@ -1,0 +1,182 @@
+// Frames, checkpoints, and the summary and plots of a finished spread member (apps/spread/spread_app.hpp).
+#include "apps/spread/spread_app.hpp"
+
+namespace dcm {
+namespace spread_app {
+
+FrameData frame_data(Model& model, NodeFields<Exec::memory_space>& fields) {
+  model.node_fields(fields);
+  return {to_host_vector(model.positions()), to_host_vector(fields.tension), to_host_vector(fields.stretch),
+          to_host_vector(fields.normal_force), to_host_vector(fields.normal_pressure)};
+}
+
+void append_h5_series(Member& m, const double* row) {
+  if (!m.h5) return;
+  std::vector<std::pair<std::string, double>> named;
+  for (std::size_t k = 0; k < kSeriesColumns.size(); ++k) named.emplace_back(kSeriesColumns[k], row[k]);
+  m.h5->append_series(named);
+}
+
+void write_frame(Member& m, const FrameData& d, double t) {
+  if (!m.h5) return;
+  const auto slice = [&](const std::vector<double>& all, int per_node) {
+    return std::vector<double>(all.begin() + per_node * m.first_node,
+                               all.begin() + per_node * (m.first_node + m.n));
+  };
+  const auto x = slice(d.x, 3), tension = slice(d.tension, 1), stretch = slice(d.stretch, 1);
+  const auto fn = slice(d.normal_force, 1), pn = slice(d.normal_pressure, 1);
+  m.h5->write_frame(t, x.data(),
+                    {{"cortex_tension_J_per_m2", 1, tension.data()},
+                     {"stretch", 1, stretch.data()},
+                     {"normal_force_N", 1, fn.data()},
+                     {"normal_pressure_Pa", 1, pn.data()}});
+}
+
+void write_checkpoint_now(Member& m, const Model& model, const Stepper& stepper, double wall) {
+  Checkpoint c;
+  c.put_text("app", "spread");
+  c.put_text("scene", m.scene.to_toml());
+  model.save_cell_state(c, m.cell);
+  stepper.save_cell_state(c, model, m.cell);
+  std::vector<double> progress;
+  for (double* f : m.p.fields()) progress.push_back(f == &m.p.wall_before ? m.p.wall_before + wall : *f);
+  c.put("app.progress", progress);
+  c.put("app.t_s", m.ts);
+  c.put("app.r_cc_m", m.rs);
+  c.put("app.contact_area_m2", m.areas_c);
+  c.put("app.height_m", m.heights);
+  c.put_text("app.series_csv", m.csv_text);
+  c.put("app.series_rows", m.series_rows);
+  c.put("app.frames", m.h5 ? static_cast<double>(m.h5->frames()) : 0.0);
+  if (m.h5) m.h5->flush();
+  write_checkpoint(m.checkpoint_path, c);
+  m.wrote_checkpoint = true;
+}
+
+[[noreturn]] void stop_on_numerical_trouble(std::vector<Member>& ms, const std::string& what) {
+  for (Member& m : ms) {
+    if (m.done) continue;
+    if (m.h5) m.h5->close();
+    m.csv.close();
+    std::rename(m.csv_tmp.c_str(), (m.out_dir + "/series.csv").c_str());
+  }
+  const Member& m = ms.front();
+  throw NumericalError(what + " — try a smaller time.dt_s or time.adaptive = true" +
+                       (ms.size() == 1 && m.wrote_checkpoint ? "; the last checkpoint is " + m.checkpoint_path
+                                                             : std::string()));
+}
+
+void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<Exec::memory_space>& fields,
+                   double wall_now) {
+  write_checkpoint_now(m, model, stepper, wall_now);
+  model.compute_forces();
+  const double t = stepper.time(m.cell);
+  write_frame(m, frame_data(model, fields), t);
+  m.csv.close();
+  std::rename(m.csv_tmp.c_str(), (m.out_dir + "/series.csv").c_str());
+  if (m.h5) m.h5->close();
+  m.done = true;
+
+  const long long done = static_cast<long long>(m.p.step);
+  const auto x = model.cell_slice(model.positions(), m.cell);
+  double ztop = -INFINITY;
+  for (int i = 0; i < m.n; ++i) ztop = std::max(ztop, x[3 * i + 2]);
+  const CapFit cap = fit_cap(x, m.plane_z, false), cap_free = fit_cap(x, m.plane_z, true);
+  int used = 0;
+  const SpreadOptions& so = m.so;
+  const double alpha = fit_exponent(m.ts, m.rs, so.early_from_s, so.early_to_s, used);
+  const double wall = m.p.wall_before + wall_now;
+  const Progress& p = m.p;
+  // A run that ends but did not resolve its dynamics says so (stderr, also with --quiet, and summary.json's
+  // "warnings"): energy bookkeeping off by more than half of the powers (unless adaptive steps at their cap
+  // explain it: the note below), or more step halvings than steps (healthy runs: below 0.25 and none;
+  // docs/model/spread.md, "Energy balance").
+  const double residual_rel = p.worst_residual_scale > 0 ? p.worst_residual / p.worst_residual_scale : 0.0;
+  std::vector<std::string> warnings;
+  char text[320];
+  const bool long_adaptive_steps = stepper.settings().adaptive && p.h_max >= 0.99 * stepper.settings().dt_max;
+  if (residual_rel > 0.5 && !long_adaptive_steps) {  // with long adaptive steps: the note below
+    std::snprintf(
+        text, sizeof text,
+        "the energy balance is off by %.2g of the powers (energy_residual_relative): the steps do not "
+        "resolve this run; use a smaller time.dt_s or time.adaptive = true",
+        residual_rel);
+    warnings.emplace_back(text);
+  }
+  if (p.halved > static_cast<double>(done) && done > 0) {
+    std::snprintf(
+        text, sizeof text,
+        "%.0f step halvings in %lld steps (bonds near d_max): time.dt_s is too long for this scene; "
+        "use a smaller one or time.adaptive = true",
+        p.halved, done);
+    warnings.emplace_back(text);
+  }
+  for (const std::string& w : warnings)
+    std::fprintf(stderr, "spread: warning: %s%s\n",
+                 m.cell > 0 || !m.so.batch.empty() ? (m.out_dir + ": ").c_str() : "", w.c_str());
+  JsonObject summary;
+  summary.add("scene", m.scene.name())
+      .add("nodes", m.n)
+      .add("interrupted", m.interrupted)
+      .add("stopped_at_max_steps", m.stopped_at_max_steps)
+      .add("restarted_from", so.restart)
+      .add("t_end_s", t)
+      .add("halved_steps", static_cast<long long>(p.halved))
+      .add("rejected_steps", static_cast<long long>(p.rejected))
+      .add("adaptive", stepper.settings().adaptive)
+      .add("dt_min_taken_s", std::isfinite(p.h_min) ? p.h_min : 0.0)
+      .add("dt_max_taken_s", p.h_max)
+      .add("r_cc_final_m", m.rs.empty() ? 0.0 : m.rs.back())
+      .add("contact_angle_deg", cap.angle_deg)
+      .add("cap_radius_m", cap.radius)
+      .add("contact_angle_free_deg", cap_free.angle_deg)
+      .add("cap_radius_free_m", cap_free.radius)
+      .add("early_exponent", alpha)
+      .add("early_window_s", std::vector<double>{so.early_from_s, so.early_to_s})
+      .add("early_window_rows", used)
+      .add("height_final_m", ztop - m.plane_z)
+      .add("steps", done)
+      .add("dt_s", m.dt)
+      .add("wall_s", wall)
+      .add("mean_cg_iterations", done > 0 ? p.cg_total / done : 0.0)
+      .add("max_cg_iterations", static_cast<long long>(p.cg_max))
+      .add("energy_residual_max_W", p.worst_residual)
+      .add("energy_residual_relative", residual_rel)
+      .add("checkpoint", m.checkpoint_path)
+      .add("warnings", warnings);
+  summary.write(m.out_dir + "/summary.json");
+  if (!m.options.quiet) {
+    // No exponent (null in summary.json) when fewer than three series rows with contact lie in the window.
+    char exponent[96];
+    if (std::isfinite(alpha))
+      std::snprintf(exponent, sizeof exponent, "%.3f", alpha);
+    else
+      std::snprintf(exponent, sizeof exponent, "none (%d rows with contact in the window)", used);
+    std::printf(
+        "  %sr_cc = %.3f um, contact angle %.1f deg (free membrane %.1f), early exponent %s (t in [%g, %g] "
+        "s), height %.3f um; "
+        "%lld steps in %.1f s, mean CG %.1f\n",
+        m.cell > 0 || !m.so.batch.empty() ? (m.out_dir + ": ").c_str() : "",
+        (m.rs.empty() ? 0.0 : m.rs.back()) * 1e6, cap.angle_deg, cap_free.angle_deg, exponent,
+        so.early_from_s, so.early_to_s, (ztop - m.plane_z) * 1e6, done, wall,
+        done > 0 ? p.cg_total / done : 0.0);
+  }
+  // Adaptive steps control the position error, not the energy bookkeeping: say when the longest steps left
+  // the energy balance unresolved (docs/model/spread.md, "Energy balance").
+  const double dt_max = stepper.settings().dt_max;
+  if (!m.options.quiet && long_adaptive_steps && residual_rel > 0.01)
+    std::printf(
+        "  note: the energy residual is %.2g of the powers with steps up to time.dt_max_s = %g s; r_cc is "
+        "controlled by time.error_tol_m, the energy balance is not resolved at these steps: lower "
+        "time.dt_max_s to resolve it\n",
+        residual_rel, dt_max);
+  if (so.plot && !m.interrupted && !m.stopped_at_max_steps) {
+    const std::string cmd = std::string(DCM_PYTHON3) + " '" + DCM_SOURCE_DIR + "/scripts/plot_spread.py' " +
+                            (m.options.quiet ? "--quiet '" : "'") + m.out_dir + "'";
+    std::fflush(stdout);  // this run's lines before the plotter's
+    if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "spread: plotting failed (%s)\n", cmd.c_str());
+  }
+}
+
+}  // namespace spread_app
+}  // namespace dcm
