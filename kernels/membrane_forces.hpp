@@ -108,6 +108,13 @@ struct MembraneScratch {
       if (tris(e, 0) < 0 || tris(e, 1) < 0)
         throw std::invalid_argument("membrane pass: edge " + std::to_string(e) +
                                     " lacks a triangle (i, j, k) or (j, i, l) with its hinge's wing");
+    // The edge pass reads one row of constants for a batch whose first and last edges share a cell: each
+    // cell's edges must be one contiguous range (upload_cells() numbers them so).
+    const auto cell = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.hinge_cell);
+    for (int e = 1; e < mesh.n_hinges; ++e)
+      if (cell(e) < cell(e - 1))
+        throw std::invalid_argument("membrane pass: the edges of a cell are not one contiguous range (edge " +
+                                    std::to_string(e) + ")");
   }
 };
 
@@ -166,7 +173,8 @@ struct EdgePass {
     for (int l = 0; l < W; ++l)
       for (int side = 0; side < 2; ++side) a0[side][l] = rest_area[tri2[2 * (base + l) + side]];
     // The cells' constants (MembraneScratch::cell_constants): one row for the batch where its edges share a
-    // cell.
+    // cell (each cell's edges are one contiguous range, checked when the scratch is made, so the first and
+    // the last lane's cells decide).
     double kb[W], ks[W], xm2[W], kcf[W], ka[W], global[W], vol[W];
     const int c_first = edge_cell[base], c_last = edge_cell[base + W - 1];
     for (int l = 0; l < W; ++l) {
@@ -255,7 +263,8 @@ struct EdgePass {
     if (any_bad)
       for (int l = first; l < W; ++l)
         if (bond_bad[l]) Kokkos::atomic_compare_exchange(overstretched, -1, base + l);
-    if (first == 0) {  // whole batches: fixed-length runs (vector stores)
+    if (first ==
+        0) {  // whole batches: fixed-length runs (moment and cos_delta as vectors, grad at stride 12)
       for (int l = 0; l < W; ++l) {
         moment[base + l] = m[l];
         cos_delta[base + l] = cd[l];

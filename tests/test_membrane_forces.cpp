@@ -19,8 +19,9 @@ using Mem = Exec::memory_space;
 using Vector = Kokkos::View<double* [3], Kokkos::LayoutRight, Mem>;
 
 // Two cells of 162 nodes (the second 10 µm away), rest state the spheres, then every coordinate scaled by
-// a random factor in [0.97, 1.03]; hinge rest angles 0 (so every hinge bends) in cell 0, the sphere's in
-// cell 1. Constants per cell, deliberately different.
+// a random factor in [0.97, 1.03]; hinge rest angles 0 (so every hinge bends) in the first half of the hinges
+// (cell 0 here), the sphere's in the rest. Constants per cell, deliberately different. Also built on other
+// cells (uneven_cells()).
 struct TwoCells {
   Exec space;
   MeshBuffers<Mem> mesh;
@@ -39,8 +40,8 @@ struct TwoCells {
     translate(b, {10e-6, 0, 0});
     return {HostCell(a), HostCell(b)};
   }
-  // Three cells of 30, 480 and 120 edges: their ranges neither start nor end on a batch of 8 lanes, so the
-  // edge pass has batches with two cells in them and a last batch that overlaps the one before it. Their
+  // Three cells of 30, 480 and 120 edges: the second and third start inside a batch of 8 lanes (batches with
+  // two cells in them) and the edge count, 630, leaves a last batch that overlaps the one before it. Their
   // constants: set three rows after construction.
   static std::vector<HostCell> uneven_cells() {
     HostMesh a = make_icosphere(0, 1.5e-6), b = make_icosphere(2, 3.25e-6), c = make_icosphere(1, 2e-6);
@@ -107,6 +108,15 @@ double max_diff(const std::vector<double>& a, const std::vector<double>& b) {
   return m;
 }
 
+// Three rows of constants, one per cell of TwoCells::uneven_cells(), deliberately different.
+void set_uneven_constants(TwoCells& s) {
+  s.bond_params = PerCell<FenePowParams, Mem>({{3.2e-6, 2.05}, {6.4e-6, 2.6}, {4e-6, 2.2}});
+  s.k_b = PerCell<double, Mem>({2.4e-19, 7e-19, 1e-19});
+  s.k_a = PerCell<double, Mem>({6e-3, 0.0, 3e-3});
+  s.k_d = PerCell<double, Mem>({6e-3, 2e-2, 1e-2});
+  s.k_v = PerCell<double, Mem>({1e4, 3e3, 5e3});
+}
+
 TEST(MembraneForces, BondsAndHingesAreNumberedAlike) {
   TwoCells s;
   EXPECT_TRUE(bonds_match_hinges(s.mesh));
@@ -138,11 +148,7 @@ TEST(MembraneForces, FusedPassEqualsThePerTermKernels) {
 TEST(MembraneForces, BatchesAcrossCellsAndAnUnevenLastBatchEqualThePerTermKernels) {
   TwoCells s(TwoCells::uneven_cells());
   ASSERT_EQ(s.mesh.n_hinges, 630);  // not a multiple of 8: the last batch overlaps
-  s.bond_params = PerCell<FenePowParams, Mem>({{3.2e-6, 2.05}, {6.4e-6, 2.6}, {4e-6, 2.2}});
-  s.k_b = PerCell<double, Mem>({2.4e-19, 7e-19, 1e-19});
-  s.k_a = PerCell<double, Mem>({6e-3, 0.0, 3e-3});
-  s.k_d = PerCell<double, Mem>({6e-3, 2e-2, 1e-2});
-  s.k_v = PerCell<double, Mem>({1e4, 3e3, 5e3});
+  set_uneven_constants(s);
   const std::vector<double> per_term = s.forces(false), scratch_per_term = s.hinge_scratch();
   const std::vector<double> fused = s.forces(true), scratch_fused = s.hinge_scratch();
   ASSERT_GT(max_abs(per_term), 0);
@@ -155,6 +161,22 @@ TEST(MembraneForces, BatchesAcrossCellsAndAnUnevenLastBatchEqualThePerTermKernel
     const std::vector<double> a(from, to), b(fused.begin() + 3 * begin[c], fused.begin() + 3 * begin[c + 1]);
     EXPECT_LE(max_diff(a, b), 1e-11 * max_abs(a)) << "cell " << c;
   }
+}
+
+TEST(MembraneForces, OverstretchedBondInTheOverlappingLastBatchIsFlagged) {
+  TwoCells s(TwoCells::uneven_cells());
+  set_uneven_constants(s);
+  // Edges 624..629 are the last batch's own lanes (base 622, lanes 2..7). Give edge 627 alone a rest length
+  // a tenth of its length: only it passes d_max, and both passes must name it.
+  auto rest = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), s.bonds.rest_length);
+  rest(627) *= 0.1;
+  Kokkos::deep_copy(s.bonds.rest_length, rest);
+  int flag_fused = -2, flag_terms = -2;
+  const std::vector<double> fused = s.forces(true, &flag_fused);
+  s.forces(false, &flag_terms);
+  EXPECT_EQ(flag_fused, 627);
+  EXPECT_EQ(flag_terms, 627);
+  for (double f : fused) EXPECT_TRUE(std::isfinite(f));
 }
 
 TEST(MembraneForces, OverstretchedBondIsFlaggedLikeThePerTermKernel) {
