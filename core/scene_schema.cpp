@@ -184,10 +184,12 @@ std::vector<ParamSpec> make_schema() {
       real_key("solver.mg_damping", "0.6", 0, 0.66, kExcl, "",
                "multigrid: the smoother's damping ω (ω λ_max(D⁻¹A) < 2 keeps the V-cycle positive definite, "
                "and λ_max ≤ 3 on the finest level)"),
-      string_key("solver.mg_bending", "auto", {"auto", "on", "off"},
-                 "multigrid: the implicit bending stiffness in the preconditioner (a positive semi-definite "
-                 "approximation on the bond pattern; the CG's operator stays exact): auto = on for cells of "
-                 "40962 nodes and more (on 10242 nodes it costs more than it saves)"),
+      string_key(
+          "solver.mg_bending", "auto", {"auto", "on", "off"},
+          "multigrid: the implicit bending stiffness in the preconditioner (a positive semi-definite "
+          "approximation on the bond pattern; the CG's operator stays exact): auto = on in the steps where "
+          "the bending is strong against the dashpots, Δt k_b / (h² (c h²/R² + c_t)) ≥ 0.5 (fine meshes, "
+          "long adaptive steps; where the dashpots dominate it costs more than it saves)"),
       bool_key(
           "solver.implicit_bending", "true",
           "bending's Gauss–Newton stiffness in the velocity solve: stable at the paper's Δt on fine meshes"),

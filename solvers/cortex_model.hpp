@@ -94,8 +94,7 @@ inline std::string batch_mismatch(const MechanicsParams& a, const MechanicsParam
       {"the curvature clamp h_min", a.h_min != b.h_min},
       {"the preconditioner (multigrid, its sweeps and damping)",
        a.multigrid != b.multigrid || a.mg.sweeps != b.mg.sweeps || a.mg.damping != b.mg.damping ||
-           a.mg.bending_min_nodes != b.mg.bending_min_nodes ||
-           a.precondition_volume != b.precondition_volume},
+           a.mg.bending != b.mg.bending || a.precondition_volume != b.precondition_volume},
       {"the implicit terms", a.implicit_bonds != b.implicit_bonds ||
                                  a.implicit_bending != b.implicit_bending ||
                                  a.implicit_tension != b.implicit_tension},
@@ -188,9 +187,14 @@ class CortexModel {
     if (p.multigrid && (p.dashpot > 0 || p.dashpot_transverse > 0)) {
       multigrid_ = make_multigrid(cells, mesh_, p.mg);
       if (!multigrid_->available) multigrid_.reset();  // no hierarchy: block-Jacobi
+      if (multigrid_) cell_bending_scale_ = bending_scales(cells);
     }
   }
 
+  // The last solve's bending_ratio() (largest over the cells; 0 without the multigrid) and whether the
+  // multigrid's level 0 held the bending (MultigridSettings::Bending).
+  double last_bending_ratio() const { return last_bending_ratio_; }
+  bool last_bending_preconditioned() const { return multigrid_ && multigrid_->bending_in_level0; }
   const MeshBuffers<Mem>& mesh() const { return mesh_; }
   const GeometryBuffers<Mem>& geometry() const { return geo_; }
   const MechanicsParams& params() const { return params_; }  // cell 0's (structure: the same for all)
@@ -427,10 +431,12 @@ class CortexModel {
     // The multigrid's fine level holds Γ, the implicit bonds and the implicit tension (same sparsity), and on
     // fine meshes an approximation of the implicit bending for the preconditioner only (fine_operator()).
     if (multigrid_) {
+      const bool bending_in_preconditioner = implicit_bending && bending_preconditioned(dt_cells);
       try {
-        update_multigrid(
-            space_, mesh_, friction_, *multigrid_, implicit_tension ? &*tension_stiffness_ : nullptr,
-            implicit_bending ? &*hinges_ : nullptr, implicit_bending ? &*bending_stiffness_ : nullptr);
+        update_multigrid(space_, mesh_, friction_, *multigrid_,
+                         implicit_tension ? &*tension_stiffness_ : nullptr,
+                         bending_in_preconditioner ? &*hinges_ : nullptr,
+                         bending_in_preconditioner ? &*bending_stiffness_ : nullptr);
       } catch (const NumericalError& e) {  // the coarse level knows the cell; the force shows where it starts
         throw NumericalError(std::string(e.what()) + "; the largest force is at node " +
                              std::to_string(largest_force_node()));
@@ -576,6 +582,45 @@ class CortexModel {
     return w;
   }
 
+  // Per cell, bending_ratio() for Δt k_b = 1 J·s (solvers/multigrid.hpp): h the mean rest bond length, R the
+  // radius of the sphere of the rest area.
+  std::vector<double> bending_scales(const std::vector<HostCell>& cells) const {
+    const auto area = to_host_vector(geo_.cell_area);
+    constexpr double pi = 3.14159265358979323846;
+    std::vector<double> scale(cells.size(), 0.0);
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      const auto& x = cells[c].mesh.nodes;
+      const auto& edges = cells[c].topology.edges;
+      if (edges.empty()) continue;
+      double sum = 0;
+      for (const auto& e : edges)
+        sum += std::sqrt((x[e[1]][0] - x[e[0]][0]) * (x[e[1]][0] - x[e[0]][0]) +
+                         (x[e[1]][1] - x[e[0]][1]) * (x[e[1]][1] - x[e[0]][1]) +
+                         (x[e[1]][2] - x[e[0]][2]) * (x[e[1]][2] - x[e[0]][2]));
+      const double h = sum / static_cast<double>(edges.size()), r = std::sqrt(area[c] / (4 * pi));
+      scale[c] = bending_ratio(1.0, h, r, cell_params_[c].dashpot, cell_params_[c].dashpot_transverse);
+    }
+    return scale;
+  }
+
+  // Whether this step's bending goes into the multigrid's level 0 (MultigridSettings::Bending).
+  bool bending_preconditioned(const std::vector<double>& dt_cells) {
+    using B = MultigridSettings::Bending;
+    last_bending_ratio_ = 0;
+    for (std::size_t c = 0; c < cell_bending_scale_.size(); ++c)
+      last_bending_ratio_ =
+          std::max(last_bending_ratio_, dt_cells[c] * k_b_.host[c] * cell_bending_scale_[c]);
+    switch (params_.mg.bending) {
+      case B::off:
+        return false;
+      case B::on:
+        return true;
+      case B::automatic:
+        break;
+    }
+    return last_bending_ratio_ >= MultigridSettings::kAutoRatio;
+  }
+
   Kokkos::View<double*, Kokkos::LayoutRight, Mem> node_drag(const std::vector<HostCell>& cells) {
     Kokkos::View<double*, Kokkos::LayoutRight, Mem> drag("dcm::model::node_drag", mesh_.n_nodes);
     auto h = Kokkos::create_mirror_view(drag);
@@ -682,6 +727,9 @@ class CortexModel {
   std::optional<GlobalStiffness<Mem>> global_;
   std::optional<GlobalWoodbury<Mem>> woodbury_;  // set: the volume term in the preconditioner
   std::optional<Multigrid<Mem>> multigrid_;
+  std::vector<double>
+      cell_bending_scale_;         // per cell, bending_ratio() per J·s of Δt k_b (with the multigrid)
+  double last_bending_ratio_ = 0;  // the largest cell's bending_ratio() of the last solve
   std::optional<BendingStiffness<Mem>> bending_stiffness_;
   std::optional<TensionStiffness<Mem>> tension_stiffness_;
   std::optional<Vector> gravity_;

@@ -38,13 +38,28 @@ namespace dcm {
 struct MultigridSettings {
   int sweeps = 2;        // ν pre- and ν post-smoothing sweeps
   double damping = 0.6;  // ω
-  // The implicit bending stiffness (solvers/bending_stiffness.hpp) in the preconditioner when some cell has
-  // at least this many nodes: level 0 then holds a positive semi-definite approximation of it on the bond
-  // pattern (docs/model/solver.md, "Bending in the preconditioner"); the operator the CG applies stays
-  // exact. On coarser meshes the dashpots dominate the bending and it would cost without saving iterations.
-  static constexpr int kBendingAuto = 40962;
-  int bending_min_nodes = kBendingAuto;
+  // The implicit bending stiffness (solvers/bending_stiffness.hpp) in the preconditioner: level 0 then holds
+  // a positive semi-definite approximation of it on the bond pattern (docs/model/solver.md, "Bending in the
+  // preconditioner"); the operator the CG applies stays exact. `off`: never (make_multigrid() builds no
+  // recipe for it); `on`: every step; `automatic`: the steps where the bending is strong against the
+  // dashpots, bending_ratio() >= kAutoRatio (solvers/cortex_model.hpp decides, step by step, from each
+  // cell's Δt). Where the dashpots dominate it costs its assembly and saves no iterations.
+  enum class Bending { automatic, on, off };
+  Bending bending = Bending::automatic;
+  static constexpr double kAutoRatio = 0.5;
 };
+
+// How strongly the implicit bending stiffens the soft (normal) modes of a cell against its dashpots, the
+// measure MultigridSettings::Bending::automatic decides by (docs/model/solver.md): a normal displacement at
+// the mesh scale h meets the bending's Δt k_b / h² and the dashpots' c (h/R)² + c_t (the axial dashpot c
+// through the facet angle, a transverse one c_t directly), so
+//   β = Δt k_b / (h² (c h²/R² + c_t)),
+// with h the cell's mean rest bond length and R the radius of the sphere of its rest area. On the paper's
+// parameters and Δt = 6 µs β ≈ 0.003 / 0.04 / 0.7 on 2562 / 10242 / 40962 nodes.
+KOKKOS_INLINE_FUNCTION double bending_ratio(double dt_k_b, double h, double radius, double c, double c_t) {
+  const double dashpots = c * h * h / (radius * radius) + c_t;
+  return dashpots > 0 ? dt_k_b / (h * h * dashpots) : (dt_k_b > 0 ? 1e300 : 0.0);
+}
 
 template <class MemorySpace>
 struct MultigridLevel {
@@ -75,7 +90,7 @@ struct Multigrid {
   // Level 0: per slot (i, j) the triangle corners (t, c_i, c_j) with tri(t, c_i) = i, tri(t, c_j) = j, packed
   // as 9 t + 3 c_i + c_j, in the order of i's triangle corners (the implicit tension blocks; topology only).
   View<int*> fine_slot_tension_offsets, fine_slot_tension;
-  // Bending in the preconditioner (a cell of settings.bending_min_nodes or more, a mesh with hinges): per
+  // Bending in the preconditioner (settings.bending not off, a mesh with hinges): per
   // slot (i, j) the hinge roles (h, a, b) with hinge(h, a) = i, hinge(h, b) = j, packed as 16 h + 4 a + b, in
   // hinge order; the wings' cross pair (2, 3) is left out and each wing's diagonal entry listed twice (the
   // approximation stays positive semi-definite). bending_axis: per hinge N̂ and √s α_a (a = 0..3) of the step.
@@ -228,10 +243,8 @@ Multigrid<MemorySpace> make_multigrid(const std::vector<HostCell>& cells,
     mg.fine_slot_tension_offsets = mg_detail::upload_vector<IV>("fine_slot_tension_offsets", offsets);
     mg.fine_slot_tension = mg_detail::upload_vector<IV>("fine_slot_tension", entries);
   }
-  int largest_cell = 0;
-  for (const HostCell& c : cells)
-    largest_cell = std::max(largest_cell, static_cast<int>(c.mesh.nodes.size()));
-  if (largest_cell >= settings.bending_min_nodes && mesh.n_hinges > 0) {  // the bending blocks of each slot
+  if (settings.bending != MultigridSettings::Bending::off &&
+      mesh.n_hinges > 0) {  // the bending blocks of each slot
     const auto hinge = to_host_vector(mesh.hinge);
     std::vector<std::vector<int>> per_slot(h.fine.cols.size());
     for (int e = 0; e < mesh.n_hinges; ++e)
@@ -299,7 +312,9 @@ void update_bending_axes(const ExecutionSpace& space, const MeshBuffers<MemorySp
 
 }  // namespace mg_detail
 
-// Numeric set-up, once per step after update_friction(space, mesh, op).
+// Numeric set-up, once per step after update_friction(space, mesh, op). Level 0 holds the bending's
+// approximation when the caller passes the hinges and the bending stiffness and make_multigrid() built its
+// recipe (settings.bending not off); the caller decides step by step (MultigridSettings::Bending).
 template <class ExecutionSpace, class MemorySpace>
 void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                       const FrictionOperator<MemorySpace>& op, Multigrid<MemorySpace>& mg,

@@ -225,6 +225,59 @@ TEST(CortexModel, ImplicitBendingIsStableWhereExplicitBendingIsNot) {
   EXPECT_TRUE(implicit_ok);
 }
 
+// MultigridSettings::Bending::automatic: the bending's Gauss–Newton stiffness enters the multigrid's level 0
+// in the steps where bending_ratio() = Δt k_b R² / (c h⁴) reaches 0.5 (solvers/multigrid.hpp), and there it
+// saves iterations; on the paper's Δt on 642 nodes it stays out.
+TEST(CortexModel, BendingEntersThePreconditionerWhereItIsStrongAgainstTheDashpots) {
+  const HostMesh rest = make_icosphere(3, 3.25e-6);
+  const Topology topo = build_topology(rest);
+  auto point = [&](int i) { return Real3{rest.nodes[i][0], rest.nodes[i][1], rest.nodes[i][2]}; };
+  double h = 0, area = 0;
+  for (const auto& e : topo.edges) h += norm(point(e[1]) - point(e[0]));
+  h /= static_cast<double>(topo.edges.size());
+  for (const auto& t : rest.triangles)
+    area += 0.5 * norm(cross(point(t[1]) - point(t[0]), point(t[2]) - point(t[0])));
+  const double r = std::sqrt(area / (4 * M_PI));
+  const double ratio_per_s = 240e-21 * r * r / (1.5e-6 * h * h * h * h);  // β / Δt, Table 1
+  HostMesh moved = perturbed_sphere(3, 0.02e-6, 5);
+  struct Solve {
+    double ratio;
+    bool preconditioned;
+    int iterations;
+  };
+  auto solve = [&](MultigridSettings::Bending mode, double dt) {
+    MechanicsParams p = table1(6e-3, 6e-3, 1e4);
+    p.multigrid = true;
+    p.implicit_bending = true;
+    p.mg.bending = mode;
+    CortexModel<Exec> model(Exec(), {HostCell(rest)}, p);
+    set_positions(model, moved);
+    model.compute_forces();
+    CgSettings cg;
+    cg.abs_tol = 0;
+    cg.rel_tol = 1e-10;
+    const CgResult res = model.solve_velocity(cg, dt);
+    EXPECT_TRUE(res.converged);
+    return Solve{model.last_bending_ratio(), model.last_bending_preconditioned(), res.iterations};
+  };
+  using B = MultigridSettings::Bending;
+  const double paper_dt = 6e-6, strong_dt = 4.0 / ratio_per_s;  // β = 4
+  const Solve paper = solve(B::automatic, paper_dt), strong = solve(B::automatic, strong_dt),
+              strong_off = solve(B::off, strong_dt), paper_on = solve(B::on, paper_dt);
+  std::printf(
+      "  642 nodes, h = %.3f um: beta = %.2e at dt = 6 us (%d iterations), beta = %.2f at dt = %.3g s: "
+      "%d iterations with the bending in the preconditioner, %d without\n",
+      h * 1e6, paper.ratio, paper.iterations, strong.ratio, strong_dt, strong.iterations,
+      strong_off.iterations);
+  EXPECT_NEAR(paper.ratio, paper_dt * ratio_per_s, 1e-9 * paper.ratio);
+  EXPECT_NEAR(strong.ratio, 4.0, 1e-9);
+  EXPECT_FALSE(paper.preconditioned);
+  EXPECT_TRUE(strong.preconditioned);
+  EXPECT_FALSE(strong_off.preconditioned);
+  EXPECT_TRUE(paper_on.preconditioned);
+  EXPECT_LT(strong.iterations, strong_off.iterations);
+}
+
 // A tense, nearly flat cortex: the Evans–Fung cell stretched 12% in its plane (area terms under tension
 // ≈ 1.5e-3 N/m) with small random displacements. Out-of-plane motion of a node of the flat faces is damped by
 // the drag alone (the axial dashpots are nearly perpendicular to it), so the tension's out-of-plane stiffness

@@ -178,7 +178,7 @@ TEST(Multigrid, FineLevelHoldsTheImplicitTension) {
   EXPECT_LT((fine - expected).norm(), 1e-12 * expected.norm());
 }
 
-// Bending in the preconditioner (MultigridSettings::bending_min_nodes): level 0 = the operator + per hinge
+// Bending in the preconditioner (MultigridSettings::bending): level 0 = the operator + per hinge
 // s [(Σ_a α_a N̂·u_a)² + (α_k N̂·u_k − α_l N̂·u_l)²], N̂ along ∇_k θ + ∇_l θ, α_a = ∇_a θ · N̂, s = Δt k_b
 // max(cos(θ − θ*), 0) (solvers/multigrid.hpp); the operator the CG applies (fine_operator()) stays Γ.
 constexpr const TensionStiffness<Mem>* kNoTension = nullptr;
@@ -186,13 +186,13 @@ constexpr const TensionStiffness<Mem>* kNoTension = nullptr;
 struct WithBending : Preconditioned {
   HingeRest<Mem> hinges;
   BendingStiffness<Mem> bs;
-  WithBending(int k, double dt_k_b, int min_nodes) : Preconditioned({k}), bs(mesh) {
+  WithBending(int k, double dt_k_b, MultigridSettings::Bending mode) : Preconditioned({k}), bs(mesh) {
     hinges = make_hinge_rest(Exec(), mesh);
     Kokkos::View<double* [3], Kokkos::LayoutRight, Mem> f("f", mesh.n_nodes);
     add_bending_forces(Exec(), mesh, hinges, 1.0, f);  // fills ∇θ and cos(θ − θ*)
     update_bending_stiffness(dt_k_b, 1.0, bs);
     MultigridSettings ms;
-    ms.bending_min_nodes = min_nodes;
+    ms.bending = mode;
     mg = make_multigrid(cells, mesh, ms);
     update_multigrid(Exec(), mesh, op, mg, kNoTension, &hinges, &bs);
   }
@@ -211,7 +211,7 @@ struct WithBending : Preconditioned {
   }
   CgResult solve_exact(bool bending_preconditioner, const Vector& f, const Vector& v) {
     MultigridSettings ms;
-    ms.bending_min_nodes = bending_preconditioner ? 0 : 1 << 30;
+    ms.bending = bending_preconditioner ? MultigridSettings::Bending::on : MultigridSettings::Bending::off;
     Multigrid<Mem> m = make_multigrid(cells, mesh, ms);
     update_multigrid(Exec(), mesh, op, m, kNoTension, &hinges, &bs);
     CgWorkspace<Mem> w(mesh.n_nodes);
@@ -230,7 +230,7 @@ struct WithBending : Preconditioned {
 
 TEST(Multigrid, BendingInTheFineLevelIsTheStatedPositiveApproximation) {
   const double dt_k_b = 6e-6 * 240e-18;  // k_b × 1000: the bending blocks are not lost in rounding
-  WithBending s(2, dt_k_b, 0);
+  WithBending s(2, dt_k_b, MultigridSettings::Bending::on);
   ASSERT_TRUE(s.mg.bending_in_level0);
   const Eigen::MatrixXd gamma = s.assemble();
   const Eigen::MatrixXd op = dense_blocks(s.mg.fine_operator());
@@ -265,8 +265,8 @@ TEST(Multigrid, BendingInTheFineLevelIsTheStatedPositiveApproximation) {
     EXPECT_NEAR(dot_host(hu, mv), dot_host(hv, mu), 1e-10 * std::sqrt(dot_host(hu, mu) * dot_host(hv, mv)));
     EXPECT_GT(dot_host(hu, mu), 0.0);
   }
-  // Below bending_min_nodes the level is Γ alone.
-  WithBending off(2, dt_k_b, 10242);
+  // Switched off, the level is Γ alone.
+  WithBending off(2, dt_k_b, MultigridSettings::Bending::off);
   EXPECT_FALSE(off.mg.bending_in_level0);
   EXPECT_LT((dense_blocks(off.mg.levels[0].a) - gamma).norm(), 1e-12 * gamma.norm());
 }
@@ -274,7 +274,9 @@ TEST(Multigrid, BendingInTheFineLevelIsTheStatedPositiveApproximation) {
 // Where the bending stiffness reaches the dashpots' soft (normal) modes, the preconditioner with it needs
 // fewer iterations for the same exact operator, and both agree with Eigen's solve.
 TEST(Multigrid, BendingInThePreconditionerSavesIterationsWhereItMatters) {
-  WithBending s(3, 6e-6 * 240e-18, 0);  // k_b × 1000: on 642 nodes as strong as the paper's on ≈ 40962
+  WithBending s(
+      3, 6e-6 * 240e-18,
+      MultigridSettings::Bending::on);  // k_b × 1000: on 642 nodes as strong as the paper's on ≈ 40962
   const Eigen::MatrixXd a = s.exact_operator();
   const Vector f = s.random_vector(11, 1e-12);
   const auto fh = to_host_vector(f);

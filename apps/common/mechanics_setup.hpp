@@ -1,7 +1,6 @@
 #pragma once
 // From a scene to the cells and the mechanical constants of a run (shared by the mechanics apps).
 #include <cmath>
-#include <limits>
 #include <string>
 #include <vector>
 
@@ -31,9 +30,8 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
   p.mg.sweeps = static_cast<int>(scene.get_int("solver.mg_sweeps"));
   p.mg.damping = scene.get_real("solver.mg_damping");
   const std::string mg_bending = scene.get_string("solver.mg_bending");
-  p.mg.bending_min_nodes = mg_bending == "on"    ? 0
-                           : mg_bending == "off" ? std::numeric_limits<int>::max()
-                                                 : MultigridSettings::kBendingAuto;
+  using Bending = MultigridSettings::Bending;
+  p.mg.bending = mg_bending == "on" ? Bending::on : mg_bending == "off" ? Bending::off : Bending::automatic;
   p.implicit_bending = scene.get_bool("solver.implicit_bending");
   p.implicit_bonds = scene.get_bool("solver.implicit_bonds");
   p.implicit_tension = scene.get_bool("solver.implicit_tension");
