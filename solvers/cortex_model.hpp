@@ -192,7 +192,7 @@ class CortexModel {
   }
 
   // The last solve's bending_ratio() (largest over the cells; 0 without the multigrid) and whether the
-  // multigrid's level 0 held the bending (MultigridSettings::Bending).
+  // multigrid's level 0 held the bending of some cell (MultigridSettings::Bending).
   double last_bending_ratio() const { return last_bending_ratio_; }
   bool last_bending_preconditioned() const { return multigrid_ && multigrid_->bending_in_level0; }
   const MeshBuffers<Mem>& mesh() const { return mesh_; }
@@ -428,15 +428,16 @@ class CortexModel {
     if (implicit_tension)
       update_tension_stiffness(space_, mesh_, geo_, *area_, k_area_local_.table(), k_area_global_.table(),
                                dt_.table(), *tension_stiffness_);
-    // The multigrid's fine level holds Γ, the implicit bonds and the implicit tension (same sparsity), and on
-    // fine meshes an approximation of the implicit bending for the preconditioner only (fine_operator()).
+    // The multigrid's fine level holds Γ, the implicit bonds and the implicit tension (same sparsity), and
+    // for the cells whose bending is strong (select_bending_cells()) an approximation of the implicit bending
+    // for the preconditioner only (fine_operator()).
     if (multigrid_) {
-      const bool bending_in_preconditioner = implicit_bending && bending_preconditioned(dt_cells);
+      if (implicit_bending) select_bending_cells(dt_cells);
       try {
         update_multigrid(space_, mesh_, friction_, *multigrid_,
                          implicit_tension ? &*tension_stiffness_ : nullptr,
-                         bending_in_preconditioner ? &*hinges_ : nullptr,
-                         bending_in_preconditioner ? &*bending_stiffness_ : nullptr);
+                         implicit_bending ? &*hinges_ : nullptr,
+                         implicit_bending ? &*bending_stiffness_ : nullptr, &bending_cells_);
       } catch (const NumericalError& e) {  // the coarse level knows the cell; the force shows where it starts
         throw NumericalError(std::string(e.what()) + "; the largest force is at node " +
                              std::to_string(largest_force_node()));
@@ -603,22 +604,18 @@ class CortexModel {
     return scale;
   }
 
-  // Whether this step's bending goes into the multigrid's level 0 (MultigridSettings::Bending).
-  bool bending_preconditioned(const std::vector<double>& dt_cells) {
+  // The cells whose bending goes into the multigrid's level 0 this step (MultigridSettings::Bending), each
+  // decided from its own Δt and constants: a cell's preconditioner does not depend on its batch.
+  void select_bending_cells(const std::vector<double>& dt_cells) {
     using B = MultigridSettings::Bending;
     last_bending_ratio_ = 0;
-    for (std::size_t c = 0; c < cell_bending_scale_.size(); ++c)
-      last_bending_ratio_ =
-          std::max(last_bending_ratio_, dt_cells[c] * k_b_.host[c] * cell_bending_scale_[c]);
-    switch (params_.mg.bending) {
-      case B::off:
-        return false;
-      case B::on:
-        return true;
-      case B::automatic:
-        break;
+    bending_cells_.assign(cell_bending_scale_.size(), 0);
+    for (std::size_t c = 0; c < cell_bending_scale_.size(); ++c) {
+      const double ratio = dt_cells[c] * k_b_.host[c] * cell_bending_scale_[c];
+      last_bending_ratio_ = std::max(last_bending_ratio_, ratio);
+      bending_cells_[c] = params_.mg.bending == B::on ||
+                          (params_.mg.bending == B::automatic && ratio >= MultigridSettings::kAutoRatio);
     }
-    return last_bending_ratio_ >= MultigridSettings::kAutoRatio;
   }
 
   Kokkos::View<double*, Kokkos::LayoutRight, Mem> node_drag(const std::vector<HostCell>& cells) {
@@ -728,8 +725,9 @@ class CortexModel {
   std::optional<GlobalWoodbury<Mem>> woodbury_;  // set: the volume term in the preconditioner
   std::optional<Multigrid<Mem>> multigrid_;
   std::vector<double>
-      cell_bending_scale_;         // per cell, bending_ratio() per J·s of Δt k_b (with the multigrid)
-  double last_bending_ratio_ = 0;  // the largest cell's bending_ratio() of the last solve
+      cell_bending_scale_;           // per cell, bending_ratio() per J·s of Δt k_b (with the multigrid)
+  double last_bending_ratio_ = 0;    // the largest cell's bending_ratio() of the last solve
+  std::vector<char> bending_cells_;  // per cell: its bending in the multigrid's level 0 (last solve)
   std::optional<BendingStiffness<Mem>> bending_stiffness_;
   std::optional<TensionStiffness<Mem>> tension_stiffness_;
   std::optional<Vector> gravity_;

@@ -41,12 +41,12 @@ struct MultigridSettings {
   // The implicit bending stiffness (solvers/bending_stiffness.hpp) in the preconditioner: level 0 then holds
   // a positive semi-definite approximation of it on the bond pattern (docs/model/solver.md, "Bending in the
   // preconditioner"); the operator the CG applies stays exact. `off`: never (make_multigrid() builds no
-  // recipe for it); `on`: every step; `automatic`: the steps where the bending is strong against the
-  // dashpots, bending_ratio() >= kAutoRatio (solvers/cortex_model.hpp decides, step by step, from each
-  // cell's Δt). Where the dashpots dominate it costs its assembly and saves no iterations.
+  // recipe for it); `on`: every step; `automatic`: in the steps where a cell's bending is strong against its
+  // dashpots, bending_ratio() >= kAutoRatio (solvers/cortex_model.hpp decides, step by step and cell by
+  // cell, from each cell's Δt). Where the dashpots dominate it costs its assembly and saves no iterations.
   enum class Bending { automatic, on, off };
   Bending bending = Bending::automatic;
-  static constexpr double kAutoRatio = 0.5;
+  static constexpr double kAutoRatio = 0.15;
 };
 
 // How strongly the implicit bending stiffens the soft (normal) modes of a cell against its dashpots, the
@@ -96,6 +96,10 @@ struct Multigrid {
   // approximation stays positive semi-definite). bending_axis: per hinge N̂ and √s α_a (a = 0..3) of the step.
   View<int*> fine_slot_bending_offsets, fine_slot_bending;
   View<double* [7]> bending_axis;
+  // Per cell, the Δt k_b level 0 holds (0: that cell's level 0 is its operator's blocks, to the bit), and its
+  // staging copy; update_multigrid() fills them.
+  View<double*> bending_dt_k_b;
+  typename View<double*>::host_mirror_type bending_dt_k_b_host;
   // Level 0's blocks without the bending (the CG's operator) while level 0 holds it; else empty.
   View<double* [6]> operator_values;
   bool bending_in_level0 = false;  // of the last update_multigrid()
@@ -266,6 +270,8 @@ Multigrid<MemorySpace> make_multigrid(const std::vector<HostCell>& cells,
     mg.fine_slot_bending_offsets = mg_detail::upload_vector<IV>("fine_slot_bending_offsets", offsets);
     mg.fine_slot_bending = mg_detail::upload_vector<IV>("fine_slot_bending", entries);
     mg.bending_axis = typename M::template View<double* [7]>("dcm::mg::bending_axis", mesh.n_hinges);
+    mg.bending_dt_k_b = DV("dcm::mg::bending_dt_k_b", mesh.n_cells);
+    mg.bending_dt_k_b_host = Kokkos::create_mirror_view(mg.bending_dt_k_b);
     mg.operator_values = typename M::template View<double* [6]>(
         Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::mg::operator_values"), mg.levels[0].a.nnz);
   }
@@ -288,11 +294,10 @@ namespace mg_detail {
 // s [(Σ_a α_a N̂·u_a)² + (α_k N̂·u_k − α_l N̂·u_l)²] ≥ 0 for every u. Every block is a multiple of N̂N̂ᵀ.
 template <class ExecutionSpace, class MemorySpace>
 void update_bending_axes(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                         const HingeRest<MemorySpace>& hinges, const BendingStiffness<MemorySpace>& bending,
-                         const Multigrid<MemorySpace>& mg) {
+                         const HingeRest<MemorySpace>& hinges, const Multigrid<MemorySpace>& mg) {
   const auto g = hinges.hinge_grad;
   const auto cos_delta = hinges.hinge_cos_delta;
-  const auto dt_k_b = bending.dt_k_b;
+  const auto dt_k_b = mg.bending_dt_k_b;  // per cell; 0 where the cell's level 0 leaves the bending out
   const auto hinge_cell = mesh.hinge_cell;
   const auto axis = mg.bending_axis;
   Kokkos::parallel_for(
@@ -314,20 +319,31 @@ void update_bending_axes(const ExecutionSpace& space, const MeshBuffers<MemorySp
 
 // Numeric set-up, once per step after update_friction(space, mesh, op). Level 0 holds the bending's
 // approximation when the caller passes the hinges and the bending stiffness and make_multigrid() built its
-// recipe (settings.bending not off); the caller decides step by step (MultigridSettings::Bending).
+// recipe (settings.bending not off), for the cells bending_cells selects (every cell when null); the caller
+// decides step by step (MultigridSettings::Bending). A cell left out gets exactly its blocks without the
+// bending, so its preconditioner does not depend on the other cells of a batch.
 template <class ExecutionSpace, class MemorySpace>
 void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                       const FrictionOperator<MemorySpace>& op, Multigrid<MemorySpace>& mg,
                       const TensionStiffness<MemorySpace>* tension = nullptr,
                       const HingeRest<MemorySpace>* hinges = nullptr,
-                      const BendingStiffness<MemorySpace>* bending = nullptr) {
-  mg.bending_in_level0 = hinges != nullptr && bending != nullptr && mg.operator_values.extent(0) > 0;
+                      const BendingStiffness<MemorySpace>* bending = nullptr,
+                      const std::vector<char>* bending_cells = nullptr) {
+  mg.bending_in_level0 = false;
+  if (hinges != nullptr && bending != nullptr && mg.operator_values.extent(0) > 0) {
+    for (int c = 0; c < static_cast<int>(mg.bending_dt_k_b_host.extent(0)); ++c) {
+      const bool in = bending_cells == nullptr || (*bending_cells)[c] != 0;
+      mg.bending_dt_k_b_host(c) = in ? bending->dt_k_b_host(c) : 0.0;
+      mg.bending_in_level0 = mg.bending_in_level0 || in;
+    }
+    if (mg.bending_in_level0) Kokkos::deep_copy(mg.bending_dt_k_b, mg.bending_dt_k_b_host);
+  }
   {  // level 0: Γ's blocks, ζ_i I + Σ_b c n̂n̂ᵀ on the diagonal, −c n̂n̂ᵀ for each bond
     const BlockCsr<MemorySpace>& a = mg.levels[0].a;
     const auto off = a.row_offsets;
     const auto val = a.values;
     const bool with_bending = mg.bending_in_level0;
-    if (with_bending) mg_detail::update_bending_axes(space, mesh, *hinges, *bending, mg);
+    if (with_bending) mg_detail::update_bending_axes(space, mesh, *hinges, mg);
     const auto op_val = mg.operator_values;
     const auto bend_off = mg.fine_slot_bending_offsets;
     const auto bend = mg.fine_slot_bending;

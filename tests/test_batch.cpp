@@ -89,6 +89,38 @@ TEST(Batch, PerCellCgSolvesEachCellAsAlone) {
               batch.cell_solves()[1].iterations);
 }
 
+// The multigrid's level 0 holds a cell's bending where that cell's own bending_ratio() asks for it
+// (MultigridSettings::Bending::automatic): a cell whose long step puts its bending in solves, in a batch
+// with a cell whose short step leaves it out, exactly as each does alone.
+TEST(Batch, BendingInThePreconditionerIsChosenPerCell) {
+  const double r = 3.25e-6, a = 0.3e-6;
+  const HostMesh sphere = make_icosphere(3, r);
+  const int n = static_cast<int>(sphere.nodes.size());
+  const MechanicsParams p = spreading(r, a);
+  const std::vector<double> dt = {6e-6, 2e-2};  // β ≈ 2e-4 and 0.6 on 642 nodes
+  CortexModel<Exec> batch(Exec(), {HostCell(sphere), HostCell(sphere)}, std::vector<MechanicsParams>{p, p});
+  CortexModel<Exec> alone0(Exec(), {HostCell(sphere)}, p), alone1(Exec(), {HostCell(sphere)}, p);
+  perturb(batch, 0, n, 0.03e-6, 1);
+  perturb(batch, n, n, 0.05e-6, 2);
+  perturb(alone0, 0, n, 0.03e-6, 1);
+  perturb(alone1, 0, n, 0.05e-6, 2);
+  CgSettings cg;
+  for (CortexModel<Exec>* m : {&batch, &alone0, &alone1}) m->compute_forces();
+  ASSERT_TRUE(batch.solve_velocity(cg, dt, nullptr).converged);
+  ASSERT_TRUE(alone0.solve_velocity(cg, dt[0]).converged);
+  ASSERT_TRUE(alone1.solve_velocity(cg, dt[1]).converged);
+  EXPECT_FALSE(alone0.last_bending_preconditioned());
+  EXPECT_TRUE(alone1.last_bending_preconditioned());
+  EXPECT_TRUE(batch.last_bending_preconditioned());
+  EXPECT_EQ(part(batch.velocity(), 0, n), part(alone0.velocity(), 0, n));
+  EXPECT_EQ(part(batch.velocity(), n, n), part(alone1.velocity(), 0, n));
+  EXPECT_EQ(batch.cell_solves()[0].iterations, alone0.cell_solves()[0].iterations);
+  EXPECT_EQ(batch.cell_solves()[1].iterations, alone1.cell_solves()[0].iterations);
+  std::printf("  beta %.2g (alone, short step) and %.2g (batch): CG iterations %d and %d\n",
+              alone0.last_bending_ratio(), batch.last_bending_ratio(), batch.cell_solves()[0].iterations,
+              batch.cell_solves()[1].iterations);
+}
+
 TEST(Batch, CellsWithDifferentConstantsStepExactlyAsAlone) {
   const double r = 3.25e-6, a = 0.3e-6;
   const HostMesh sphere = make_icosphere(3, r);

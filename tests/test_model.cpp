@@ -226,7 +226,7 @@ TEST(CortexModel, ImplicitBendingIsStableWhereExplicitBendingIsNot) {
 }
 
 // MultigridSettings::Bending::automatic: the bending's Gauss–Newton stiffness enters the multigrid's level 0
-// in the steps where bending_ratio() = Δt k_b R² / (c h⁴) reaches 0.5 (solvers/multigrid.hpp), and there it
+// in the steps where bending_ratio() = Δt k_b R² / (c h⁴) reaches 0.15 (solvers/multigrid.hpp), and there it
 // saves iterations; on the paper's Δt on 642 nodes it stays out.
 TEST(CortexModel, BendingEntersThePreconditionerWhereItIsStrongAgainstTheDashpots) {
   const HostMesh rest = make_icosphere(3, 3.25e-6);
