@@ -187,9 +187,9 @@ std::vector<ParamSpec> make_schema() {
       string_key(
           "solver.mg_bending", "auto", {"auto", "on", "off"},
           "multigrid: the implicit bending stiffness in the preconditioner (a positive semi-definite "
-          "approximation on the bond pattern; the CG's operator stays exact): auto = on in the steps where "
-          "the bending is strong against the dashpots, Δt k_b / (h² (c h²/R² + c_t)) ≥ 0.5 (fine meshes, "
-          "long adaptive steps; where the dashpots dominate it costs more than it saves)"),
+          "approximation on the bond pattern; the CG's operator stays exact): auto = for each cell in the "
+          "steps where its bending is strong against its dashpots, Δt k_b / (h² (c h²/R² + c_t)) ≥ 0.15 "
+          "(fine meshes, long adaptive steps; where the dashpots dominate it costs more than it saves)"),
       bool_key(
           "solver.implicit_bending", "true",
           "bending's Gauss–Newton stiffness in the velocity solve: stable at the paper's Δt on fine meshes"),
