@@ -185,7 +185,9 @@ class CortexModel {
     for (const MechanicsParams& q : cell_params_)
       friction_.cell_rows.push_back({q.dashpot, q.dashpot_transverse, q.gamma_n, q.gamma_t, q.pin_friction});
     if (p.multigrid && (p.dashpot > 0 || p.dashpot_transverse > 0)) {
-      multigrid_ = make_multigrid(cells, mesh_, p.mg);
+      MultigridSettings mg = p.mg;  // no recipe for a bending that never enters the solve
+      if (p.k_b == 0 || !p.implicit_bending) mg.bending = MultigridSettings::Bending::off;
+      multigrid_ = make_multigrid(cells, mesh_, mg);
       if (!multigrid_->available) multigrid_.reset();  // no hierarchy: block-Jacobi
       if (multigrid_) cell_bending_scale_ = bending_scales(cells);
     }
@@ -432,7 +434,10 @@ class CortexModel {
     // for the cells whose bending is strong (select_bending_cells()) an approximation of the implicit bending
     // for the preconditioner only (fine_operator()).
     if (multigrid_) {
-      if (implicit_bending) select_bending_cells(dt_cells);
+      if (implicit_bending)
+        select_bending_cells(dt_cells);
+      else
+        last_bending_ratio_ = 0;
       try {
         update_multigrid(space_, mesh_, friction_, *multigrid_,
                          implicit_tension ? &*tension_stiffness_ : nullptr,

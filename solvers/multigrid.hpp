@@ -303,6 +303,10 @@ void update_bending_axes(const ExecutionSpace& space, const MeshBuffers<MemorySp
   Kokkos::parallel_for(
       "dcm::mg::bending_axis", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_hinges),
       KOKKOS_LAMBDA(const int h) {
+        if (dt_k_b(hinge_cell(h)) == 0) {  // a cell left out: exact zeros, whatever its gradients hold
+          for (int k = 0; k < 7; ++k) axis(h, k) = 0;
+          return;
+        }
         const Real3 wings{g(h, 2, 0) + g(h, 3, 0), g(h, 2, 1) + g(h, 3, 1), g(h, 2, 2) + g(h, 3, 2)};
         const double len = norm(wings);
         const Real3 n = len > 0 ? (1.0 / len) * wings : Real3{0, 0, 0};

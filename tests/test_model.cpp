@@ -245,11 +245,12 @@ TEST(CortexModel, BendingEntersThePreconditionerWhereItIsStrongAgainstTheDashpot
     bool preconditioned;
     int iterations;
   };
-  auto solve = [&](MultigridSettings::Bending mode, double dt) {
+  auto solve = [&](MultigridSettings::Bending mode, double dt, double c_t = 0) {
     MechanicsParams p = table1(6e-3, 6e-3, 1e4);
     p.multigrid = true;
     p.implicit_bending = true;
     p.mg.bending = mode;
+    p.dashpot_transverse = c_t;
     CortexModel<Exec> model(Exec(), {HostCell(rest)}, p);
     set_positions(model, moved);
     model.compute_forces();
@@ -264,6 +265,13 @@ TEST(CortexModel, BendingEntersThePreconditionerWhereItIsStrongAgainstTheDashpot
   const double paper_dt = 6e-6, strong_dt = 4.0 / ratio_per_s;  // β = 4
   const Solve paper = solve(B::automatic, paper_dt), strong = solve(B::automatic, strong_dt),
               strong_off = solve(B::off, strong_dt), paper_on = solve(B::on, paper_dt);
+  // A transverse dashpot (cortex.dashpot = "relative": c_t = c) resists the normal modes directly.
+  const double c = 1.5e-6, relative_dt = 1e-3;
+  const double relative_ratio = relative_dt * 240e-21 / (h * h * (c * h * h / (r * r) + c));
+  EXPECT_NEAR(solve(B::automatic, relative_dt, c).ratio, relative_ratio, 1e-9 * relative_ratio);
+  // The threshold, MultigridSettings::kAutoRatio = 0.15, from both sides.
+  EXPECT_FALSE(solve(B::automatic, 0.14 / ratio_per_s).preconditioned);
+  EXPECT_TRUE(solve(B::automatic, 0.16 / ratio_per_s).preconditioned);
   std::printf(
       "  642 nodes, h = %.3f um: beta = %.2e at dt = 6 us (%d iterations), beta = %.2f at dt = %.3g s: "
       "%d iterations with the bending in the preconditioner, %d without\n",
