@@ -263,8 +263,8 @@ struct EdgePass {
     if (any_bad)
       for (int l = first; l < W; ++l)
         if (bond_bad[l]) Kokkos::atomic_compare_exchange(overstretched, -1, base + l);
-    if (first ==
-        0) {  // whole batches: fixed-length runs (moment and cos_delta as vectors, grad at stride 12)
+    // Whole batches: fixed-length runs (moment and cos_delta as vectors, grad at stride 12).
+    if (first == 0) {
       for (int l = 0; l < W; ++l) {
         moment[base + l] = m[l];
         cos_delta[base + l] = cd[l];
