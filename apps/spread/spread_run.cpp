@@ -1,4 +1,5 @@
 // The time loop of a batch of spread members; one member is an ordinary run (apps/spread/spread_app.hpp).
+// run_members() is the loop; the functions above it are its steps, in the order it calls them.
 #include "apps/spread/spread_app.hpp"
 
 namespace dcm {
@@ -8,6 +9,320 @@ volatile std::sig_atomic_t g_stop = 0;
 
 namespace {
 extern "C" void on_signal(int) { g_stop = 1; }
+
+// Each member's output folder and file names; earlier outputs removed only once every member's folder is
+// there, so that a refused batch removes nothing.
+void prepare_output_folders(std::vector<Member>& ms) {
+  for (Member& m : ms) {
+    m.out_dir = m.restart ? std::filesystem::path(m.so.restart).parent_path().lexically_normal().string()
+                          : prepare_output_dir(m.options, m.scene);
+    if (m.out_dir.empty()) m.out_dir = ".";
+    m.checkpoint_path = m.out_dir + "/checkpoint.h5";
+    m.wrote_checkpoint = m.restart.has_value();
+    m.csv_tmp = m.out_dir + "/series.csv.part";
+  }
+  for (Member& m : ms)
+    if (!m.restart)
+      remove_earlier_outputs(
+          m.out_dir, {"summary.json", "series.csv", "series.csv.part", "spread.h5", "spread.xmf",
+                      "checkpoint.h5", "checkpoint.h5.tmp", "r_cc.png", "cells.png", "side_views.png"});
+}
+
+// The model of the members that are still running, each a cell (its rest state from its own mesh).
+Model make_model(const std::vector<Member*>& running) {
+  std::vector<HostCell> cells;
+  std::vector<MechanicsParams> params;
+  int first = 0;
+  for (std::size_t k = 0; k < running.size(); ++k) {
+    Member& m = *running[k];
+    cells.emplace_back(m.mesh);
+    params.push_back(m.params);
+    m.cell = static_cast<int>(k);
+    m.first_node = first;
+    m.n = static_cast<int>(m.mesh.nodes.size());
+    first += m.n;
+  }
+  return Model(Exec(), cells, params);
+}
+
+// A restart (a one-member run): the cell, the stepper and what the run had written, from the checkpoint.
+void restore_from_checkpoint(Member& m, Model& model, Stepper& stepper) {
+  const Checkpoint& c = *m.restart;
+  model.restore_cell_state(c, m.cell);
+  stepper.restore_cell_state(c, model, m.cell);
+  const auto progress = m.p.fields();
+  const std::vector<double>& saved = c.array("app.progress", progress.size());
+  for (std::size_t i = 0; i < progress.size(); ++i) *progress[i] = saved[i];
+  m.ts = c.array("app.t_s");
+  m.rs = c.array("app.r_cc_m", m.ts.size());
+  m.areas_c = c.array("app.contact_area_m2", m.ts.size());
+  m.heights = c.array("app.height_m", m.ts.size());
+  m.csv_text = c.text("app.series_csv");
+  if (c.arrays.count("app.series_rows")) {
+    m.series_rows = c.array("app.series_rows");
+  } else {  // a checkpoint from before session 15: the CSV's digits, and the exact columns it kept
+    m.series_rows = parse_series_rows(m.csv_text);
+    const std::size_t w = kSeriesColumns.size();
+    for (std::size_t i = 0; i < m.ts.size() && (i + 1) * w <= m.series_rows.size(); ++i) {
+      m.series_rows[i * w + 0] = m.ts[i];
+      m.series_rows[i * w + 1] = m.rs[i];
+      m.series_rows[i * w + 2] = m.areas_c[i];
+      m.series_rows[i * w + 7] = m.heights[i];
+    }
+  }
+  m.frames_before = static_cast<int>(c.scalar("app.frames"));
+}
+
+// spread.h5 (new, or resumed after the restart's frames) and series.csv.part with the rows so far.
+void open_member_files(Member& m, const Model& model, const Stepper& stepper) {
+  std::vector<int> tri, node_cell(m.n, 0);
+  for (const Tri& t : m.mesh.triangles) tri.insert(tri.end(), t.begin(), t.end());
+  if (!m.scene.get_bool("output.hdf5")) {
+    m.h5.reset();
+  } else if (m.restart) {
+    m.h5 = std::make_unique<H5Output>(m.out_dir + "/spread.h5", H5Output::Resume{m.frames_before});
+  } else {
+    m.h5 = std::make_unique<H5Output>(m.out_dir + "/spread.h5");
+    m.h5->write_text("scene", m.scene.to_toml());
+    m.h5->write_mesh(model.cell_slice(model.positions(), m.cell).data(), m.n, tri.data(),
+                     static_cast<int>(m.mesh.triangles.size()), node_cell.data());
+  }
+  for (std::size_t i = 0; i + kSeriesColumns.size() <= m.series_rows.size(); i += kSeriesColumns.size())
+    append_h5_series(m, &m.series_rows[i]);
+  m.csv.open(m.csv_tmp, std::ios::trunc);
+  m.csv << m.csv_text;
+  if (!m.csv) throw IoError(m.csv_tmp + ": cannot write");
+  m.steps_before = static_cast<long long>(m.p.step);
+  m.last = stepper.time(m.cell) >= m.t_end * (1 - 1e-12);
+  m.last_checkpoint = std::chrono::steady_clock::now();
+}
+
+// The first line on the terminal: what runs, on what.
+void print_banner(const std::vector<Member>& ms, const Stepper& stepper) {
+  if (ms.size() > 1) {
+    std::printf("dcm spread: a batch of %zu members (%d nodes each) in one model; %s\n", ms.size(), ms[0].n,
+                kokkos_description().c_str());
+    return;
+  }
+  const Member& m = ms.front();
+  if (m.restart)
+    std::printf(
+        "dcm spread: restart from %s at t = %.6g s (step %lld), scene '%s', %d nodes, t_end = %.3g s; %s\n",
+        m.so.restart.c_str(), stepper.time(m.cell), static_cast<long long>(m.p.step), m.scene.name().c_str(),
+        m.n, m.t_end, kokkos_description().c_str());
+  else
+    std::printf(
+        "dcm spread: scene '%s', %d nodes, %s, t_end = %.3g s; %s\n", m.scene.name().c_str(), m.n,
+        m.steps.adaptive
+            ? ("adaptive steps from dt = " + detail::format_real(m.dt) + " s").c_str()
+            : ("dt = " + detail::format_real(m.dt) + " s (" +
+               std::to_string(static_cast<long long>(std::ceil(m.t_end / m.dt * (1 - 1e-12)))) + " steps)")
+                  .c_str(),
+        m.t_end, kokkos_description().c_str());
+}
+
+// Per cell, the cap on the next step (0: the member is not stepping); false when no member runs any more.
+bool plan_step(std::vector<Member>& ms, const Stepper& stepper, std::vector<double>& cap) {
+  bool any_running = false;
+  for (Member& m : ms) {
+    if (m.last || m.done) continue;
+    any_running = true;
+    m.t = stepper.time(m.cell);
+    m.index = static_cast<long long>(m.p.step);
+    // The last step lands on t_end (a fixed-step run's last step may be up to 1.5 Δt long, as before).
+    const double remaining = m.t_end - m.t;
+    m.h_cap = m.steps.adaptive ? remaining : (remaining < 1.5 * m.dt ? remaining : INFINITY);
+    cap[m.cell] = m.h_cap;
+  }
+  return any_running;
+}
+
+// Before the step, on the state at t (the stepper calls it once the steps are planned): the frames due now,
+// which members write a series row after this step, and their energy and powers at t.
+struct BeforeStep {
+  std::vector<Member>& ms;
+  const std::vector<double>& cap;
+  Model& model;
+  NodeFields<Exec::memory_space>& fields;
+  std::vector<double> e0, pc, dis;
+
+  void operator()(const std::vector<double>& h_planned) {
+    bool any_sample = false;
+    std::optional<FrameData> frame;  // computed once, for every member that writes a frame now
+    for (Member& m : ms) {
+      m.sample = false;
+      if (m.done || cap[m.cell] == 0) continue;
+      const double t = m.t;
+      Progress& p = m.p;
+      const auto next_figure = static_cast<std::size_t>(p.next_figure);
+      if (t >= p.next_frame - 1e-12 ||
+          (next_figure < kFigureTimes.size() && t >= kFigureTimes[next_figure] - 1e-12)) {
+        if (!frame) frame = frame_data(model, fields);
+        write_frame(m, *frame, t);
+        while (p.next_frame <= t + 1e-12) p.next_frame += m.frame_every;
+        std::size_t f = next_figure;
+        while (f < kFigureTimes.size() && kFigureTimes[f] <= t + 1e-12) ++f;
+        p.next_figure = static_cast<double>(f);
+      }
+      m.sample = t >= p.next_sample || m.index < 10 || h_planned[m.cell] >= m.h_cap;
+      any_sample = any_sample || m.sample;
+    }
+    if (any_sample) {  // each cell's own sums (solvers/cortex_model.hpp): the bits of its run alone
+      model.energy(&e0);
+      model.contact_power(&pc);
+      model.dissipation(&dis);
+      for (Member& m : ms)
+        if (m.sample) {
+          m.e0 = e0[m.cell];
+          m.pc = pc[m.cell];
+          m.dis = dis[m.cell];
+        }
+    }
+  }
+};
+
+// After the step, the state at t + h that the sampled members' rows need (read once for all of them).
+struct AfterStep {
+  std::vector<double> energy, contact_area, contact_load, cell_area, cell_volume, x;
+  bool any_row = false;
+
+  void read(const std::vector<Member>& ms, const std::vector<double>& cap, Model& model) {
+    any_row = false;
+    for (const Member& m : ms) any_row = any_row || (!m.done && cap[m.cell] > 0 && m.sample);
+    if (!any_row) return;
+    model.energy(&energy);
+    model.contact_area(&contact_area);
+    model.contact_load(&contact_load);
+    cell_area = to_host_vector(model.geometry().cell_area);
+    cell_volume = to_host_vector(model.geometry().cell_volume);
+    x = to_host_vector(model.positions());
+  }
+};
+
+// One series row of a sampled member after its step r (to series.csv.part, spread.h5 and the fits' columns),
+// with the step's energy balance: (E(t+h) − E(t))/h against the contact power minus the dissipation.
+void record_row(std::vector<Member>& ms, Member& m, const StepReport& r, const AfterStep& after,
+                const Model& model) {
+  Progress& p = m.p;
+  const double h = r.h, t = m.t;
+  const double e_after = after.energy[m.cell], de = (e_after - m.e0) / h, residual = de - (m.pc - m.dis);
+  p.worst_residual = std::max(p.worst_residual, std::fabs(residual));
+  p.worst_residual_scale = std::max(p.worst_residual_scale, std::fabs(m.dis) + std::fabs(m.pc));
+  const double area_c = after.contact_area[m.cell];
+  if (!(area_c >= 0)) {  // not finite: the state is no longer a cell
+    const auto tri_area_c = to_host_vector(model.contact()->tri_contact_area);
+    const int t0 = model.mesh().host_cell_tri_begin[m.cell],
+              t1 = model.mesh().host_cell_tri_begin[m.cell + 1];
+    int bad = t0;
+    while (bad < t1 && tri_area_c[bad] >= 0) ++bad;
+    stop_on_numerical_trouble(ms, "step " + std::to_string(m.index) + " (t = " + detail::format_real(t + h) +
+                                      " s): the contact area is " + detail::format_real(area_c) +
+                                      " m² (first at triangle " + std::to_string(bad - t0) + ")" +
+                                      (ms.size() > 1 ? " of member " + m.out_dir : std::string()));
+  }
+  const double r_cc = std::sqrt(area_c / kPi);
+  double ztop = -INFINITY;
+  for (int i = m.first_node; i < m.first_node + m.n; ++i) ztop = std::max(ztop, after.x[3 * i + 2]);
+  const double row[] = {t + h,
+                        r_cc,
+                        area_c,
+                        after.cell_area[m.cell],
+                        after.cell_volume[m.cell],
+                        static_cast<double>(r.iterations),
+                        h,
+                        ztop - m.plane_z,
+                        after.contact_load[m.cell],
+                        e_after,
+                        de,
+                        m.pc,
+                        m.dis,
+                        residual};
+  static_assert(sizeof row / sizeof row[0] == 14, "one value per series column");
+  char line[512];
+  std::snprintf(line, sizeof line, "%.9g,%.9g,%.9g,%.9g,%.9g,%d,%.6g,%.9g,%.9g,%.12g,%.6g,%.6g,%.6g,%.6g\n",
+                row[0], row[1], row[2], row[3], row[4], r.iterations, row[6], row[7], row[8], row[9], row[10],
+                row[11], row[12], row[13]);
+  m.csv << line;
+  m.csv_text += line;
+  m.ts.push_back(t + h);
+  m.rs.push_back(r_cc);
+  m.areas_c.push_back(area_c);
+  m.heights.push_back(ztop - m.plane_z);
+  m.series_rows.insert(m.series_rows.end(), row, row + kSeriesColumns.size());
+  append_h5_series(m, row);
+  p.next_sample = (t + h) * std::pow(10.0, 1.0 / m.per_decade);
+}
+
+// The step's counts into the member's progress, and its row if it was sampled.
+void account_step(std::vector<Member>& ms, Member& m, const StepReport& r, const AfterStep& after,
+                  const Model& model, const Stepper& stepper) {
+  Progress& p = m.p;
+  p.step += 1;
+  m.last = stepper.time(m.cell) >= m.t_end * (1 - 1e-12);
+  p.cg_total += r.iterations;
+  p.cg_max = std::max(p.cg_max, static_cast<double>(r.iterations));
+  p.halved += r.halvings;
+  p.rejected += r.rejections;
+  p.h_min = std::min(p.h_min, r.h);
+  p.h_max = std::max(p.h_max, r.h);
+  if (m.sample) record_row(ms, m, r, after, model);
+  m.stopped_at_max_steps = m.so.max_steps > 0 && p.step >= static_cast<double>(m.so.max_steps) && !m.last;
+}
+
+// One line of progress (simulated time, rate, ETA; for a batch, the slowest member).
+void print_progress(const std::vector<Member>& ms, const Model& model, const Stepper& stepper,
+                    const std::vector<StepReport>& rep, long long batch_steps, double wall) {
+  if (ms.size() == 1) {
+    const Member& m = ms.front();
+    const double h = rep[0].h, rate = (m.p.step - m.steps_before) / wall;
+    std::printf("  t = %.4f s  r_cc = %.3f um  dt = %.2g s  CG %d it  %.0f steps/s  ETA %.0f s\n",
+                stepper.time(0), std::sqrt(model.contact_area() / kPi) * 1e6, h, rep[0].iterations, rate,
+                (m.t_end - stepper.time(0)) / h / rate);
+  } else {
+    int running = 0;
+    double slowest = 1;
+    for (const Member& m : ms)
+      if (!m.last && !m.done) {
+        ++running;
+        slowest = std::min(slowest, stepper.time(m.cell) / m.t_end);
+      }
+    std::printf(
+        "  batch step %lld: %d of %zu members running, the slowest at %.1f%% of its t_end, %.0f "
+        "batch steps/s\n",
+        batch_steps, running, ms.size(), 100 * slowest, batch_steps / wall);
+  }
+  std::fflush(stdout);
+}
+
+// Members that reached their t_end: final state written; they leave the model, and the others continue in a
+// model of their own cells, bit for bit (nothing a cell computes depends on the other cells, and each cell's
+// rest state comes from its member's mesh): a finished cell costs nothing more.
+void retire_finished(std::vector<Member>& ms, Model& model, Stepper& stepper,
+                     NodeFields<Exec::memory_space>& fields, double wall) {
+  bool left = false;
+  for (Member& m : ms)
+    if (!m.done && m.last) {
+      finish_member(m, model, stepper, fields, wall);
+      left = true;
+    }
+  std::vector<Member*> running;
+  for (Member& m : ms)
+    if (!m.done) running.push_back(&m);
+  if (!left || running.empty()) return;
+  std::vector<Checkpoint> state(running.size());
+  for (std::size_t k = 0; k < running.size(); ++k) {
+    model.save_cell_state(state[k], running[k]->cell);
+    stepper.save_cell_state(state[k], model, running[k]->cell);
+  }
+  model = make_model(running);
+  fields = NodeFields<Exec::memory_space>(model.mesh().n_nodes);
+  stepper = Stepper(model, ms.front().steps);
+  for (std::size_t k = 0; k < running.size(); ++k) {
+    model.restore_cell_state(state[k], static_cast<int>(k));
+    stepper.restore_cell_state(state[k], model, static_cast<int>(k));
+  }
+}
+
 }  // namespace
 
 // Runs the members as one batch (one member: the ordinary run). Forward Euler at the scene's fixed Δt (the
@@ -29,162 +344,31 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
         std::printf("spread: scene %s: ok (checked, nothing written)\n", m.scene.name().c_str());
     return;
   }
-  for (Member& m : ms) {
-    m.out_dir = m.restart ? std::filesystem::path(m.so.restart).parent_path().lexically_normal().string()
-                          : prepare_output_dir(m.options, m.scene);
-    if (m.out_dir.empty()) m.out_dir = ".";
-    m.checkpoint_path = m.out_dir + "/checkpoint.h5";
-    m.wrote_checkpoint = m.restart.has_value();
-    m.csv_tmp = m.out_dir + "/series.csv.part";
-  }
-  for (Member& m : ms)  // only once every member's folder is there: a refused batch removes nothing
-    if (!m.restart)
-      remove_earlier_outputs(
-          m.out_dir, {"summary.json", "series.csv", "series.csv.part", "spread.h5", "spread.xmf",
-                      "checkpoint.h5", "checkpoint.h5.tmp", "r_cc.png", "cells.png", "side_views.png"});
+  prepare_output_folders(ms);
   KokkosSession kokkos(threads);
   const auto wall0 = std::chrono::steady_clock::now();
 
-  // The model of the members that are still running, each a cell (its rest state from its own mesh).
-  const auto make_model = [&](const std::vector<Member*>& running) {
-    std::vector<HostCell> cells;
-    std::vector<MechanicsParams> params;
-    int first = 0;
-    for (std::size_t k = 0; k < running.size(); ++k) {
-      Member& m = *running[k];
-      cells.emplace_back(m.mesh);
-      params.push_back(m.params);
-      m.cell = static_cast<int>(k);
-      m.first_node = first;
-      m.n = static_cast<int>(m.mesh.nodes.size());
-      first += m.n;
-    }
-    return Model(Exec(), cells, params);
-  };
   std::vector<Member*> all;
   for (Member& m : ms) all.push_back(&m);
   Model model = make_model(all);
   NodeFields<Exec::memory_space> fields(model.mesh().n_nodes);
   Stepper stepper(model, ms.front().steps);
   for (Member& m : ms) {
-    if (m.restart) {  // a restart is a one-member run
-      const Checkpoint& c = *m.restart;
-      model.restore_cell_state(c, m.cell);
-      stepper.restore_cell_state(c, model, m.cell);
-      const auto progress = m.p.fields();
-      const std::vector<double>& saved = c.array("app.progress", progress.size());
-      for (std::size_t i = 0; i < progress.size(); ++i) *progress[i] = saved[i];
-      m.ts = c.array("app.t_s");
-      m.rs = c.array("app.r_cc_m", m.ts.size());
-      m.areas_c = c.array("app.contact_area_m2", m.ts.size());
-      m.heights = c.array("app.height_m", m.ts.size());
-      m.csv_text = c.text("app.series_csv");
-      if (c.arrays.count("app.series_rows")) {
-        m.series_rows = c.array("app.series_rows");
-      } else {  // a checkpoint from before session 15: the CSV's digits, and the exact columns it kept
-        m.series_rows = parse_series_rows(m.csv_text);
-        const std::size_t w = kSeriesColumns.size();
-        for (std::size_t i = 0; i < m.ts.size() && (i + 1) * w <= m.series_rows.size(); ++i) {
-          m.series_rows[i * w + 0] = m.ts[i];
-          m.series_rows[i * w + 1] = m.rs[i];
-          m.series_rows[i * w + 2] = m.areas_c[i];
-          m.series_rows[i * w + 7] = m.heights[i];
-        }
-      }
-      m.frames_before = static_cast<int>(c.scalar("app.frames"));
-    }
-    std::vector<int> tri, node_cell(m.n, 0);
-    for (const Tri& t : m.mesh.triangles) tri.insert(tri.end(), t.begin(), t.end());
-    if (!m.scene.get_bool("output.hdf5")) {
-      m.h5.reset();
-    } else if (m.restart) {
-      m.h5 = std::make_unique<H5Output>(m.out_dir + "/spread.h5", H5Output::Resume{m.frames_before});
-    } else {
-      m.h5 = std::make_unique<H5Output>(m.out_dir + "/spread.h5");
-      m.h5->write_text("scene", m.scene.to_toml());
-      m.h5->write_mesh(model.cell_slice(model.positions(), m.cell).data(), m.n, tri.data(),
-                       static_cast<int>(m.mesh.triangles.size()), node_cell.data());
-    }
-    for (std::size_t i = 0; i + kSeriesColumns.size() <= m.series_rows.size(); i += kSeriesColumns.size())
-      append_h5_series(m, &m.series_rows[i]);
-    m.csv.open(m.csv_tmp, std::ios::trunc);
-    m.csv << m.csv_text;
-    if (!m.csv) throw IoError(m.csv_tmp + ": cannot write");
-    m.steps_before = static_cast<long long>(m.p.step);
-    m.last = stepper.time(m.cell) >= m.t_end * (1 - 1e-12);
-    m.last_checkpoint = std::chrono::steady_clock::now();
-    if (quiet) continue;
-    if (m.restart)
-      std::printf(
-          "dcm spread: restart from %s at t = %.6g s (step %lld), scene '%s', %d nodes, t_end = %.3g s; %s\n",
-          m.so.restart.c_str(), stepper.time(m.cell), static_cast<long long>(m.p.step),
-          m.scene.name().c_str(), m.n, m.t_end, kokkos_description().c_str());
-    else if (ms.size() == 1)
-      std::printf(
-          "dcm spread: scene '%s', %d nodes, %s, t_end = %.3g s; %s\n", m.scene.name().c_str(), m.n,
-          m.steps.adaptive
-              ? ("adaptive steps from dt = " + detail::format_real(m.dt) + " s").c_str()
-              : ("dt = " + detail::format_real(m.dt) + " s (" +
-                 std::to_string(static_cast<long long>(std::ceil(m.t_end / m.dt * (1 - 1e-12)))) + " steps)")
-                    .c_str(),
-          m.t_end, kokkos_description().c_str());
+    if (m.restart) restore_from_checkpoint(m, model, stepper);
+    open_member_files(m, model, stepper);
   }
-  if (!quiet && ms.size() > 1)
-    std::printf("dcm spread: a batch of %zu members (%d nodes each) in one model; %s\n", ms.size(), ms[0].n,
-                kokkos_description().c_str());
+  if (!quiet) print_banner(ms, stepper);
 
   auto last_progress = std::chrono::steady_clock::now();
-  std::vector<double> cap, e0, pc, dis, e1, area_cells, load_cells;
+  std::vector<double> cap;
+  AfterStep after;
   long long batch_steps = 0;
   for (;;) {
-    bool any_running = false;
     cap.assign(model.n_cells(), 0.0);
-    for (Member& m : ms) {
-      if (m.last || m.done) continue;
-      any_running = true;
-      m.t = stepper.time(m.cell);
-      m.index = static_cast<long long>(m.p.step);
-      // The last step lands on t_end (a fixed-step run's last step may be up to 1.5 Δt long, as before).
-      const double remaining = m.t_end - m.t;
-      m.h_cap = m.steps.adaptive ? remaining : (remaining < 1.5 * m.dt ? remaining : INFINITY);
-      cap[m.cell] = m.h_cap;
-    }
-    if (!any_running) break;
+    if (!plan_step(ms, stepper, cap)) break;
     std::vector<StepReport> rep;
     try {
-      rep = stepper.step(model, ms.front().cg, cap, [&](const std::vector<double>& h_planned) {
-        bool any_sample = false;
-        std::optional<FrameData> frame;  // computed once, for every member that writes a frame now
-        for (Member& m : ms) {
-          m.sample = false;
-          if (m.done || cap[m.cell] == 0) continue;
-          const double t = m.t;
-          Progress& p = m.p;
-          const auto next_figure = static_cast<std::size_t>(p.next_figure);
-          if (t >= p.next_frame - 1e-12 ||
-              (next_figure < kFigureTimes.size() && t >= kFigureTimes[next_figure] - 1e-12)) {
-            if (!frame) frame = frame_data(model, fields);
-            write_frame(m, *frame, t);
-            while (p.next_frame <= t + 1e-12) p.next_frame += m.frame_every;
-            std::size_t f = next_figure;
-            while (f < kFigureTimes.size() && kFigureTimes[f] <= t + 1e-12) ++f;
-            p.next_figure = static_cast<double>(f);
-          }
-          m.sample = t >= p.next_sample || m.index < 10 || h_planned[m.cell] >= m.h_cap;
-          any_sample = any_sample || m.sample;
-        }
-        if (any_sample) {  // each cell's own sums (solvers/cortex_model.hpp): the bits of its run alone
-          model.energy(&e0);
-          model.contact_power(&pc);
-          model.dissipation(&dis);
-          for (Member& m : ms)
-            if (m.sample) {
-              m.e0 = e0[m.cell];
-              m.pc = pc[m.cell];
-              m.dis = dis[m.cell];
-            }
-        }
-      });
+      rep = stepper.step(model, ms.front().cg, cap, BeforeStep{ms, cap, model, fields, {}, {}, {}});
     } catch (const NumericalError& e) {
       const Member& m = ms.front();
       stop_on_numerical_trouble(ms, (ms.size() == 1 ? "step " + std::to_string(m.index) + " (t = " +
@@ -193,107 +377,12 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
                                         e.what());
     }
     ++batch_steps;
-    bool any_row = false;
-    for (Member& m : ms) any_row = any_row || (!m.done && cap[m.cell] > 0 && m.sample);
-    if (any_row) {  // after the step: each sampled member's row
-      model.energy(&e1);
-      model.contact_area(&area_cells);
-      model.contact_load(&load_cells);
-    }
-    const std::vector<double> cell_area =
-        any_row ? to_host_vector(model.geometry().cell_area) : std::vector<double>();
-    const std::vector<double> cell_volume =
-        any_row ? to_host_vector(model.geometry().cell_volume) : std::vector<double>();
-    const std::vector<double> x_all = any_row ? to_host_vector(model.positions()) : std::vector<double>();
-    for (Member& m : ms) {
-      if (m.done || cap[m.cell] == 0) continue;
-      const StepReport& r = rep[m.cell];
-      Progress& p = m.p;
-      p.step += 1;
-      const double h = r.h, t = m.t;
-      m.last = stepper.time(m.cell) >= m.t_end * (1 - 1e-12);
-      p.cg_total += r.iterations;
-      p.cg_max = std::max(p.cg_max, static_cast<double>(r.iterations));
-      p.halved += r.halvings;
-      p.rejected += r.rejections;
-      p.h_min = std::min(p.h_min, h);
-      p.h_max = std::max(p.h_max, h);
-      if (m.sample) {
-        // Energy balance of the step: (E(t+h) − E(t))/h against the contact power minus the dissipation.
-        const double e_after = e1[m.cell], de = (e_after - m.e0) / h, residual = de - (m.pc - m.dis);
-        p.worst_residual = std::max(p.worst_residual, std::fabs(residual));
-        p.worst_residual_scale = std::max(p.worst_residual_scale, std::fabs(m.dis) + std::fabs(m.pc));
-        const double area_c = area_cells[m.cell];
-        if (!(area_c >= 0)) {  // not finite: the state is no longer a cell
-          const auto tri_area_c = to_host_vector(model.contact()->tri_contact_area);
-          const int t0 = model.mesh().host_cell_tri_begin[m.cell],
-                    t1 = model.mesh().host_cell_tri_begin[m.cell + 1];
-          int bad = t0;
-          while (bad < t1 && tri_area_c[bad] >= 0) ++bad;
-          stop_on_numerical_trouble(ms, "step " + std::to_string(m.index) +
-                                            " (t = " + detail::format_real(t + h) +
-                                            " s): the contact area is " + detail::format_real(area_c) +
-                                            " m² (first at triangle " + std::to_string(bad - t0) + ")" +
-                                            (ms.size() > 1 ? " of member " + m.out_dir : std::string()));
-        }
-        const double r_cc = std::sqrt(area_c / kPi);
-        double ztop = -INFINITY;
-        for (int i = m.first_node; i < m.first_node + m.n; ++i) ztop = std::max(ztop, x_all[3 * i + 2]);
-        const double row[] = {t + h,
-                              r_cc,
-                              area_c,
-                              cell_area[m.cell],
-                              cell_volume[m.cell],
-                              static_cast<double>(r.iterations),
-                              h,
-                              ztop - m.plane_z,
-                              load_cells[m.cell],
-                              e_after,
-                              de,
-                              m.pc,
-                              m.dis,
-                              residual};
-        static_assert(sizeof row / sizeof row[0] == 14, "one value per series column");
-        char line[512];
-        std::snprintf(line, sizeof line,
-                      "%.9g,%.9g,%.9g,%.9g,%.9g,%d,%.6g,%.9g,%.9g,%.12g,%.6g,%.6g,%.6g,%.6g\n", row[0],
-                      row[1], row[2], row[3], row[4], r.iterations, row[6], row[7], row[8], row[9], row[10],
-                      row[11], row[12], row[13]);
-        m.csv << line;
-        m.csv_text += line;
-        m.ts.push_back(t + h);
-        m.rs.push_back(r_cc);
-        m.areas_c.push_back(area_c);
-        m.heights.push_back(ztop - m.plane_z);
-        m.series_rows.insert(m.series_rows.end(), row, row + kSeriesColumns.size());
-        append_h5_series(m, row);
-        p.next_sample = (t + h) * std::pow(10.0, 1.0 / m.per_decade);
-      }
-      m.stopped_at_max_steps = m.so.max_steps > 0 && p.step >= static_cast<double>(m.so.max_steps) && !m.last;
-    }
+    after.read(ms, cap, model);
+    for (Member& m : ms)
+      if (!m.done && cap[m.cell] != 0) account_step(ms, m, rep[m.cell], after, model, stepper);
     // Progress every 2 s of wall time, independent of the (log-spaced) series rows.
     if (!quiet && seconds_since(last_progress) > 2.0) {
-      const double wall = seconds_since(wall0);
-      if (ms.size() == 1) {
-        const Member& m = ms.front();
-        const double h = rep[0].h, rate = (m.p.step - m.steps_before) / wall;
-        std::printf("  t = %.4f s  r_cc = %.3f um  dt = %.2g s  CG %d it  %.0f steps/s  ETA %.0f s\n",
-                    stepper.time(0), std::sqrt(model.contact_area() / kPi) * 1e6, h, rep[0].iterations, rate,
-                    (m.t_end - stepper.time(0)) / h / rate);
-      } else {
-        int running = 0;
-        double slowest = 1;
-        for (const Member& m : ms)
-          if (!m.last && !m.done) {
-            ++running;
-            slowest = std::min(slowest, stepper.time(m.cell) / m.t_end);
-          }
-        std::printf(
-            "  batch step %lld: %d of %zu members running, the slowest at %.1f%% of its t_end, %.0f "
-            "batch steps/s\n",
-            batch_steps, running, ms.size(), 100 * slowest, batch_steps / wall);
-      }
-      std::fflush(stdout);
+      print_progress(ms, model, stepper, rep, batch_steps, seconds_since(wall0));
       last_progress = std::chrono::steady_clock::now();
     }
     bool stop_all = false;
@@ -310,32 +399,7 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
         write_checkpoint_now(m, model, stepper, seconds_since(wall0));
         m.last_checkpoint = std::chrono::steady_clock::now();
       }
-    // Members that reached their t_end: final state written; they leave the model, and the others continue
-    // in a model of their own cells, bit for bit (nothing a cell computes depends on the other cells, and
-    // each cell's rest state comes from its member's mesh): a finished cell costs nothing more.
-    bool left = false;
-    for (Member& m : ms)
-      if (!m.done && m.last) {
-        finish_member(m, model, stepper, fields, seconds_since(wall0));
-        left = true;
-      }
-    std::vector<Member*> running;
-    for (Member& m : ms)
-      if (!m.done) running.push_back(&m);
-    if (left && !running.empty()) {
-      std::vector<Checkpoint> state(running.size());
-      for (std::size_t k = 0; k < running.size(); ++k) {
-        model.save_cell_state(state[k], running[k]->cell);
-        stepper.save_cell_state(state[k], model, running[k]->cell);
-      }
-      model = make_model(running);
-      fields = NodeFields<Exec::memory_space>(model.mesh().n_nodes);
-      stepper = Stepper(model, ms.front().steps);
-      for (std::size_t k = 0; k < running.size(); ++k) {
-        model.restore_cell_state(state[k], static_cast<int>(k));
-        stepper.restore_cell_state(state[k], model, static_cast<int>(k));
-      }
-    }
+    retire_finished(ms, model, stepper, fields, seconds_since(wall0));
   }
   // The final state of the members still open (interrupted or stopped at --max-steps).
   for (Member& m : ms)
