@@ -10,7 +10,8 @@ echo "test.sh: build done after ${SECONDS} s" >&2
 start=$SECONDS
 (cd "$builddir" && ctest --output-on-failure --parallel "$(nproc)" "$@")
 echo "test.sh: ctest took $((SECONDS - start)) s" >&2
-# Then every unit and I/O test again, built with ASan + UBSan (about 12 minutes with the build).
+# Then every unit and I/O test again, built with ASan + UBSan (about 10 minutes with the build; session 19:
+# build 6.8 min, tests 3.5 min).
 if [ "${DCM_SKIP_SANITIZE:-0}" != 1 ]; then
   start=$SECONDS
   bash scripts/sanitize.sh
