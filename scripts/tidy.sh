@@ -10,10 +10,11 @@ tidy=$(command -v clang-tidy || command -v clang-tidy-14 || true)
 [ -f build/compile_commands.json ] || bash scripts/build.sh release > /dev/null
 files=("$@")
 [ ${#files[@]} -gt 0 ] || mapfile -t files < <(git ls-files 'core/*.cpp' 'apps/*.cpp')
-# The build's commands without GCC's -mtune-ctrl (CMakeLists.txt: no gathers), which clang refuses.
+# The build's commands without GCC's switches against gathers (CMakeLists.txt), which clang may refuse.
 db=$(mktemp -d)
 trap 'rm -rf "$db"' EXIT
-sed -E 's/ (\\")?-mtune-ctrl=[^ "\\]*(\\")?//g' build/compile_commands.json > "$db/compile_commands.json"
+sed -E -e 's/ (\\")?-mtune-ctrl=[^ "\\]*(\\")?//g' -e 's/ -mno-(gather|scatter)//g' build/compile_commands.json \
+  > "$db/compile_commands.json"
 # GCC's default dialect is C++17, so CMake records no -std flag; clang's is older.
 printf '%s\n' "${files[@]}" | xargs -P "$(nproc)" -n 1 "$tidy" -p "$db" --quiet --extra-arg=-std=c++17 \
   --extra-arg=-Wno-unknown-warning-option

@@ -298,11 +298,11 @@ void print_progress(const std::vector<Member>& ms, const Model& model, const Ste
 // model of their own cells, bit for bit (nothing a cell computes depends on the other cells, and each cell's
 // rest state comes from its member's mesh): a finished cell costs nothing more.
 void retire_finished(std::vector<Member>& ms, Model& model, Stepper& stepper,
-                     NodeFields<Exec::memory_space>& fields, double wall) {
+                     NodeFields<Exec::memory_space>& fields, std::chrono::steady_clock::time_point wall0) {
   bool left = false;
   for (Member& m : ms)
     if (!m.done && m.last) {
-      finish_member(m, model, stepper, fields, wall);
+      finish_member(m, model, stepper, fields, seconds_since(wall0));
       left = true;
     }
   std::vector<Member*> running;
@@ -399,7 +399,7 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
         write_checkpoint_now(m, model, stepper, seconds_since(wall0));
         m.last_checkpoint = std::chrono::steady_clock::now();
       }
-    retire_finished(ms, model, stepper, fields, seconds_since(wall0));
+    retire_finished(ms, model, stepper, fields, wall0);
   }
   // The final state of the members still open (interrupted or stopped at --max-steps).
   for (Member& m : ms)
