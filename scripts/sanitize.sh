@@ -3,7 +3,7 @@
 # build-sanitize/, -O1, against the release Kokkos) and runs every one of them: any memory error, leak or
 # undefined behaviour fails the run. Part of scripts/test.sh (CI).
 #   scripts/sanitize.sh [gtest filter for dcm_unit_tests]   (default: all; dcm_io_tests always run in full)
-# The tests run in two lanes side by side (below): about 1.5 minutes on 2 cores (session 20). Kokkos' own bounds checks are
+# The tests run in two lanes side by side (below): about 2 minutes on 2 cores (session 20). Kokkos' own bounds checks are
 # the debug preset's (scripts/build.sh debug).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -16,7 +16,7 @@ filter=${1:-*}
 # Two lanes, one per core, one OpenMP thread each (the I/O tests: two). The two slowest unit tests under the
 # sanitizers share a lane with a quarter of the other unit tests; the I/O tests and the other three quarters
 # make the second lane. Session 20 (Zen 5 VM), with both slow tests on the multigrid preconditioner: 40 and
-# 20 s alone, 83 s together while the other lane runs; the rest of the unit tests about 90 s, the I/O tests
+# 20 s alone, 63-83 s together while the other lane runs; the rest of the unit tests about 90 s, the I/O tests
 # 16 s. gtest's own two shards put both slow tests in one shard (106 s against 41 s). A failing part of a lane
 # does not stop the lane's other parts. With a filter the unit tests run as two gtest shards.
 slow_a=CortexModel.ImplicitTensionIsStableWhereExplicitTensionIsNot
