@@ -37,9 +37,15 @@
 #include "kernels/area_constraints.hpp"
 #include "kernels/bending.hpp"
 #include "kernels/fene_pow_bonds.hpp"
+#include "kernels/membrane_edge_pass.hpp"
+#include "kernels/membrane_edge_simd.hpp"
 #include "kernels/volume_constraint.hpp"
 
 namespace dcm {
+
+// Which form of the edge pass runs: the fastest this build has for the execution space (the default), the
+// portable lanes (EdgePass<8> on the host), or one edge per work item (the device form). Tests run all three.
+enum class MembraneEdgeKernel { fastest, lanes, one_edge };
 
 // Items per work item of the triangle and edge passes: 8 where the execution space runs on the host (SIMD
 // lanes), 1 on a device (CUDA, HIP, SYCL: one thread per item). Asked of the execution space, not of its
@@ -92,16 +98,25 @@ struct MembraneScratch {
   // Per cell and call, the constants of the edge pass: k_b, k_s, x_max^2, k_s / (1 - 1/x_max^2), k_a,
   // k_d (A_c - A_c*)/A_c* (N/m) and -k_v (V_c - V_c*)/(3 V_c*) (Pa), eqs. 24, 26-29; one row per cell.
   static constexpr int kCellConstants = 8;
-  Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace> slot_force;  // per (node, hinge entry) (N)
-  Kokkos::View<int* [4], Kokkos::LayoutRight, MemorySpace> edge_slot;      // slot of (edge, hinge node)
-  Kokkos::View<int* [2], Kokkos::LayoutRight, MemorySpace> edge_tri;       // triangles of the wings k, l
+  Kokkos::View<double* [4], Kokkos::LayoutRight, MemorySpace>
+      slot_force;  // per (node, hinge entry): x, y, z, 0 (N)
+  Kokkos::View<int* [4], Kokkos::LayoutRight, MemorySpace> edge_slot;  // slot of (edge, hinge node)
+  Kokkos::View<int* [2], Kokkos::LayoutRight, MemorySpace> edge_tri;   // triangles of the wings k, l
   Kokkos::View<double* [kCellConstants], Kokkos::LayoutRight, MemorySpace> cell_constants;
+  // The vector pass of host builds (kernels/membrane_edge_simd.hpp) loads the positions from a padded copy.
+#if defined(DCM_MEMBRANE_EDGE_SIMD)
+  static constexpr bool kHostSimd = Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemorySpace>::accessible;
+#else
+  static constexpr bool kHostSimd = false;
+#endif
+  Kokkos::View<double* [4], Kokkos::LayoutRight, MemorySpace> x4;  // [node]: x, y, z, 0 (empty without it)
   MembraneScratch() = default;
   explicit MembraneScratch(const MeshBuffers<MemorySpace>& mesh)
       : slot_force("dcm::membrane::slot_force", 4 * mesh.n_hinges),
         edge_slot("dcm::membrane::edge_slot", mesh.n_hinges),
         edge_tri("dcm::membrane::edge_tri", mesh.n_hinges),
-        cell_constants("dcm::membrane::cell_constants", mesh.n_cells) {
+        cell_constants("dcm::membrane::cell_constants", mesh.n_cells),
+        x4("dcm::membrane::x4", kHostSimd ? mesh.n_nodes : 0) {
     fill_membrane_slots(mesh, edge_slot, edge_tri);
     const auto tris = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), edge_tri);
     for (int e = 0; e < mesh.n_hinges; ++e)
@@ -130,168 +145,6 @@ bool bonds_match_hinges(const MeshBuffers<MemorySpace>& mesh) {
   return true;
 }
 
-namespace membrane_detail {
-
-// The edge pass on W consecutive edges per work item (docs/model/membrane_pass.md). Raw pointers with
-// compile-time strides: the lanes' loads and stores are most of the pass, and a View's runtime strides
-// cost an integer multiply per access.
-template <int W>
-struct EdgePass {
-  int n;                         // edges (n >= W)
-  const double* x;               // positions [node][3]
-  const int* hinge;              // [edge][4] (i, j, k, l)
-  const int* slot;               // [edge][4] the slots of (i, j, k, l)
-  const int* tri2;               // [edge][2] the wings' triangles
-  const int* edge_cell;          // [edge]
-  const double* rest_length;     // [edge] d*
-  const double* rest_trig;       // [edge][2] (cos theta*, sin theta*)
-  const double* rest_area;       // [triangle] A_t*
-  const double* cell_constants;  // [cell][K]
-  double* out;                   // [slot][3]
-  double* grad;                  // [edge][4][3] dtheta/dx per role
-  double* moment;                // [edge]
-  double* cos_delta;             // [edge]
-  int* overstretched;
-  static constexpr int K = 8;
-
-  KOKKOS_INLINE_FUNCTION void operator()(const int batch) const {
-    const int start = batch * W;
-    // The last batch overlaps the one before it (same lanes, same bits) and stores only its new edges.
-    const int base = start + W <= n ? start : n - W, first = start - base;
-    double p[4][3][W];
-    for (int l = 0; l < W; ++l)
-      for (int v = 0; v < 4; ++v) {
-        const double* xv = x + 3 * hinge[4 * (base + l) + v];
-        for (int d = 0; d < 3; ++d) p[v][d][l] = xv[d];
-      }
-    double dr[W], cr[W], sr[W], a0[2][W];
-    for (int l = 0; l < W; ++l) {
-      dr[l] = rest_length[base + l];
-      cr[l] = rest_trig[2 * (base + l)];
-      sr[l] = rest_trig[2 * (base + l) + 1];
-    }
-    for (int l = 0; l < W; ++l)
-      for (int side = 0; side < 2; ++side) a0[side][l] = rest_area[tri2[2 * (base + l) + side]];
-    // The cells' constants (MembraneScratch::cell_constants): one row for the batch where its edges share a
-    // cell (each cell's edges are one contiguous range, checked when the scratch is made, so the first and
-    // the last lane's cells decide).
-    double kb[W], ks[W], xm2[W], kcf[W], ka[W], global[W], vol[W];
-    const int c_first = edge_cell[base], c_last = edge_cell[base + W - 1];
-    for (int l = 0; l < W; ++l) {
-      const double* k = cell_constants + K * (c_first == c_last ? c_first : edge_cell[base + l]);
-      kb[l] = k[0];
-      ks[l] = k[1];
-      xm2[l] = k[2];
-      kcf[l] = k[3];
-      ka[l] = k[4];
-      global[l] = k[5];
-      vol[l] = k[6];
-    }
-    double g[4][3][W], m[W], cd[W], o[4][3][W];
-    int bond_bad[W];
-    for (int l = 0; l < W; ++l) {
-      const double ex = p[1][0][l] - p[0][0][l], ey = p[1][1][l] - p[0][1][l],
-                   ez = p[1][2][l] - p[0][2][l];  // e = x_j - x_i
-      const double ax = p[2][0][l] - p[0][0][l], ay = p[2][1][l] - p[0][1][l],
-                   az = p[2][2][l] - p[0][2][l];  // x_k - x_i
-      const double bx = p[3][0][l] - p[1][0][l], by = p[3][1][l] - p[1][1][l],
-                   bz = p[3][2][l] - p[1][2][l];  // x_l - x_j
-      // n1 = e x a = 2 A_1 n_1 of triangle (i, j, k); n2 = b x e = 2 A_2 n_2 of triangle (j, i, l)
-      const double n1x = ey * az - ez * ay, n1y = ez * ax - ex * az, n1z = ex * ay - ey * ax;
-      const double n2x = by * ez - bz * ey, n2y = bz * ex - bx * ez, n2z = bx * ey - by * ex;
-      const double e2 = ex * ex + ey * ey + ez * ez;
-      const double n1_2 = n1x * n1x + n1y * n1y + n1z * n1z, n2_2 = n2x * n2x + n2y * n2y + n2z * n2z;
-      const double d_rest = dr[l], d_max2 = xm2[l] * d_rest * d_rest;
-      // Bond (eqs. 21-24): usable for 0 < d < d_max; hinge: for non-degenerate triangles.
-      const bool bond_ok = (e2 > 0) & (e2 < d_max2);  // false for NaN too (& keeps the lanes branch-free)
-      const bool hinge_ok = (e2 > 0) & (n1_2 > 0) & (n2_2 > 0);
-      const double e2s = e2 > 0 ? e2 : 1.0, gap = bond_ok ? d_max2 - e2 : 1.0;
-      const double n1s = n1_2 > 0 ? n1_2 : 1.0, n2s = n2_2 > 0 ? n2_2 : 1.0;
-      const double len = math::sqrt(e2s), r1 = math::sqrt(n1s), r2 = math::sqrt(n2s);  // |e|, |n1|, |n2|
-      // One division for the four reciprocals 1/|e|, 1/gap, 1/|n1|, 1/|n2|.
-      const double q = 1.0 / (len * gap * r1 * r2);
-      const double inv_len = q * gap * r1 * r2, inv_gap = q * len * r1 * r2;
-      const double inv_r1 = q * len * gap * r2, inv_r2 = q * len * gap * r1;
-      const double inv_n1 = inv_r1 * inv_r1, inv_n2 = inv_r2 * inv_r2;  // 1/|n1|^2, 1/|n2|^2
-      // U'(d)/d = k_s d_max^2 / (d_max^2 - d^2) - k_c / d^3, k_c = k_s d*^3 / (1 - 1/x_max^2) (eq. 24)
-      const double k_c = kcf[l] * d_rest * d_rest * d_rest;
-      const double u = bond_ok ? ks[l] * d_max2 * inv_gap - k_c * inv_len * inv_len * inv_len : 0.0;
-      bond_bad[l] = bond_ok ? 0 : 1;
-      // Hinge (eq. 26), kernels/bending.hpp's hinge_trig_gradient() with these reciprocals.
-      const double inv = inv_r1 * inv_r2 * inv_len;  // 1 / (|e| |n1| |n2|)
-      const double c = hinge_ok ? len * (n1x * n2x + n1y * n2y + n1z * n2z) * inv : 1.0;
-      const double s =
-          hinge_ok
-              ? ((n1y * n2z - n1z * n2y) * ex + (n1z * n2x - n1x * n2z) * ey + (n1x * n2y - n1y * n2x) * ez) *
-                    inv
-              : 0.0;
-      const double gk = hinge_ok ? -len * inv_n1 : 0.0, gl = hinge_ok ? -len * inv_n2 : 0.0;
-      const double inv_e2 = inv_len * inv_len;
-      const double ak = (ax * ex + ay * ey + az * ez) * inv_e2;
-      const double al = (bx * ex + by * ey + bz * ez) * inv_e2 + 1.0;  // (x_l - x_i) . e / |e|^2
-      const double n1v[3] = {n1x, n1y, n1z}, n2v[3] = {n2x, n2y, n2z}, ev[3] = {ex, ey, ez};
-      const double mm = -kb[l] * (s * cr[l] - c * sr[l]);  // -M = -k_b sin(theta - theta*), eq. 26
-      m[l] = mm;
-      cd[l] = c * cr[l] + s * sr[l];
-      // The wings' area and volume forces (each triangle's corner opposite this edge; the triangle's
-      // other corners get theirs from its other two edges), kernels/area_constraints.hpp and
-      // volume_constraint.hpp with A = |n|/2 and unit normal n/|n|:
-      //   F = -(1/2) [k_a (A - A*)/A* + k_d (A_c - A_c*)/A_c*] n/|n| x (x_c - x_b)   (eqs. 27, 28)
-      //       - k_v (V_c - V_c*)/V_c* (A/3) n/|n|                                      (eq. 29)
-      // with x_c - x_b = e for the wing k of (i, j, k) and -e for the wing l of (j, i, l). A degenerate
-      // triangle (n = 0) gets no force, as in the per-term kernels.
-      const double h1 = -0.5 * (ka[l] * (0.5 * r1 - a0[0][l]) / a0[0][l] + global[l]) * inv_r1;
-      const double h2 = 0.5 * (ka[l] * (0.5 * r2 - a0[1][l]) / a0[1][l] + global[l]) * inv_r2;
-      const double v2 = 0.5 * vol[l];
-      const double w1[3] = {n1y * ez - n1z * ey, n1z * ex - n1x * ez, n1x * ey - n1y * ex};  // n1 x e
-      const double w2[3] = {n2y * ez - n2z * ey, n2z * ex - n2x * ez, n2x * ey - n2y * ex};  // n2 x e
-      for (int d = 0; d < 3; ++d) {
-        const double g2 = gk * n1v[d], g3 = gl * n2v[d];
-        const double g0 = (ak - 1) * g2 + (al - 1) * g3, g1 = -ak * g2 - al * g3;
-        g[0][d][l] = g0;
-        g[1][d][l] = g1;
-        g[2][d][l] = g2;
-        g[3][d][l] = g3;
-        o[0][d][l] = mm * g0 + u * ev[d];  // the bond's force on i: U'(d)/d (x_j - x_i); on j the opposite
-        o[1][d][l] = mm * g1 - u * ev[d];
-        o[2][d][l] = mm * g2 + (h1 * w1[d] + v2 * n1v[d]);
-        o[3][d][l] = mm * g3 + (h2 * w2[d] + v2 * n2v[d]);
-      }
-    }
-    int any_bad = 0;
-    for (int l = 0; l < W; ++l) any_bad |= bond_bad[l];
-    if (any_bad)
-      for (int l = first; l < W; ++l)
-        if (bond_bad[l]) Kokkos::atomic_compare_exchange(overstretched, -1, base + l);
-    // Whole batches: fixed-length runs (moment and cos_delta as vectors, grad at stride 12).
-    if (first == 0) {
-      for (int l = 0; l < W; ++l) {
-        moment[base + l] = m[l];
-        cos_delta[base + l] = cd[l];
-      }
-      for (int v = 0; v < 4; ++v)
-        for (int d = 0; d < 3; ++d)
-          for (int l = 0; l < W; ++l) grad[12 * (base + l) + 3 * v + d] = g[v][d][l];
-    } else if (W > 1) {
-      for (int l = first; l < W; ++l) {
-        moment[base + l] = m[l];
-        cos_delta[base + l] = cd[l];
-        for (int v = 0; v < 4; ++v)
-          for (int d = 0; d < 3; ++d) grad[12 * (base + l) + 3 * v + d] = g[v][d][l];
-      }
-    }
-    for (int l = first; l < W; ++l)
-      for (int v = 0; v < 4; ++v) {
-        double* o_v = out + 3 * slot[4 * (base + l) + v];
-        o_v[0] = o[v][0][l];
-        o_v[1] = o[v][1][l];
-        o_v[2] = o[v][2][l];
-      }
-  }
-};
-
-}  // namespace membrane_detail
-
 // force += bonds + bending + area + volume forces. Needs update_geometry() on the current mesh.x (the cells'
 // area and volume; the triangles' areas and normals are recomputed from the positions). Requires
 // bonds_match_hinges(mesh). A zero constant costs its arithmetic but no extra pass. overstretched: set to -1
@@ -304,9 +157,10 @@ void add_membrane_forces(const ExecutionSpace& space, const MeshBuffers<MemorySp
                          const VolumeRest<MemorySpace>& volume_rest, const KV& k_v,
                          const MembraneScratch<MemorySpace>& scratch,
                          const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& force,
-                         const Kokkos::View<int, MemorySpace>& overstretched) {
-  constexpr int K = MembraneScratch<MemorySpace>::kCellConstants;
-  static_assert(K == membrane_detail::EdgePass<1>::K, "one row layout");
+                         const Kokkos::View<int, MemorySpace>& overstretched,
+                         const MembraneEdgeKernel kernel = MembraneEdgeKernel::fastest) {
+  static_assert(MembraneScratch<MemorySpace>::kCellConstants == membrane_detail::EdgePassArgs::K,
+                "one row layout");
   const int n = mesh.n_hinges;
   {  // Per cell, once per call: the edge pass's constants, the global area and volume factors included.
     const auto cell_area = geo.cell_area;
@@ -334,35 +188,73 @@ void add_membrane_forces(const ExecutionSpace& space, const MeshBuffers<MemorySp
   const auto grad = hinge_rest.hinge_grad;
   if (mesh.x.stride_0() != 3 || mesh.hinge.stride_0() != 4 || scratch.edge_slot.stride_0() != 4 ||
       scratch.edge_tri.stride_0() != 2 || hinge_rest.rest_trig.stride_0() != 2 || grad.stride_0() != 12 ||
-      scratch.slot_force.stride_0() != 3)
+      scratch.slot_force.stride_0() != 4)
     throw std::logic_error("add_membrane_forces: a View is padded");
+  membrane_detail::EdgePassArgs args;
+  args.n = n;
+  args.x = mesh.x.data();
+  args.hinge = mesh.hinge.data();
+  args.slot = scratch.edge_slot.data();
+  args.tri2 = scratch.edge_tri.data();
+  args.edge_cell = mesh.hinge_cell.data();
+  args.rest_length = bond_rest.rest_length.data();
+  args.rest_trig = hinge_rest.rest_trig.data();
+  args.rest_area = area_rest.tri_area.data();
+  args.cell_constants = scratch.cell_constants.data();
+  args.out = scratch.slot_force.data();
+  args.grad = grad.data();
+  args.moment = hinge_rest.hinge_moment.data();
+  args.cos_delta = hinge_rest.hinge_cos_delta.data();
+  args.overstretched = overstretched.data();
   auto run = [&](auto pass) {
-    constexpr int W = decltype(pass)::value;
-    membrane_detail::EdgePass<W> f;
-    f.n = n;
-    f.x = mesh.x.data();
-    f.hinge = mesh.hinge.data();
-    f.slot = scratch.edge_slot.data();
-    f.tri2 = scratch.edge_tri.data();
-    f.edge_cell = mesh.hinge_cell.data();
-    f.rest_length = bond_rest.rest_length.data();
-    f.rest_trig = hinge_rest.rest_trig.data();
-    f.rest_area = area_rest.tri_area.data();
-    f.cell_constants = scratch.cell_constants.data();
-    f.out = scratch.slot_force.data();
-    f.grad = grad.data();
-    f.moment = hinge_rest.hinge_moment.data();
-    f.cos_delta = hinge_rest.hinge_cos_delta.data();
-    f.overstretched = overstretched.data();
+    constexpr int W = decltype(pass)::W;
     Kokkos::parallel_for("dcm::membrane::edges",
-                         Kokkos::RangePolicy<ExecutionSpace>(space, 0, (n + W - 1) / W), f);
+                         Kokkos::RangePolicy<ExecutionSpace>(space, 0, (n + W - 1) / W), pass);
   };
   constexpr int W = MembraneLanes<ExecutionSpace>::value;
-  if (n >= W)
-    run(std::integral_constant<int, W>{});
-  else
-    run(std::integral_constant<int, 1>{});
+  const bool lanes = n >= W && kernel != MembraneEdgeKernel::one_edge;
+#if defined(DCM_MEMBRANE_EDGE_SIMD)
+  constexpr bool host_simd = W == 8 && MembraneScratch<MemorySpace>::kHostSimd;
+#else
+  constexpr bool host_simd = false;
+#endif
+  if constexpr (host_simd) {
+    if (lanes && kernel == MembraneEdgeKernel::fastest) {
+      // The padded copy of the positions that the vector pass loads one 4-vector per node from.
+      const auto x = mesh.x;
+      const auto x4 = scratch.x4;
+      Kokkos::parallel_for(
+          "dcm::membrane::x4", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
+          KOKKOS_LAMBDA(const int i) {
+            x4(i, 0) = x(i, 0);
+            x4(i, 1) = x(i, 1);
+            x4(i, 2) = x(i, 2);
+          });
+      membrane_detail::EdgePassSimd8 pass;
+      static_cast<membrane_detail::EdgePassArgs&>(pass) = args;
+      pass.x4 = x4.data();
+      run(pass);
+    } else if (lanes) {
+      run(membrane_detail::EdgePass<W>{args});
+    } else {
+      run(membrane_detail::EdgePass<1>{args});
+    }
+  } else if (lanes) {
+    run(membrane_detail::EdgePass<W>{args});
+  } else {
+    run(membrane_detail::EdgePass<1>{args});
+  }
   // 2. Node gather: the node's slots, contiguous.
+#if defined(DCM_MEMBRANE_EDGE_SIMD)
+  if constexpr (host_simd) {
+    if (force.stride_0() != 3) throw std::logic_error("add_membrane_forces: the force View is padded");
+    const membrane_detail::GatherSimd gather{mesh.node_hinge_offsets.data(), scratch.slot_force.data(),
+                                             force.data()};
+    Kokkos::parallel_for("dcm::membrane::gather", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_nodes),
+                         gather);
+    return;
+  }
+#endif
   {
     const auto hinge_offsets = mesh.node_hinge_offsets;
     const auto in = scratch.slot_force;

@@ -191,7 +191,7 @@ CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& pr
   std::vector<char> active(n_seg, 0);
   int n_active = 0;
   const auto publish = [&] {  // w.active = the segments still iterating
-    for (int s = 0; s < n_seg; ++s) w.active_host(s) = active[s];
+    for (int s = 0; s < n_seg; ++s) w.active_host(s) = active[s] != 0 ? 1 : 0;
     Kokkos::deep_copy(space, w.active, w.active_host);
   };
   for (int s = 0; s < n_seg; ++s) active[s] = frozen && (*frozen)[s] ? 0 : 1;

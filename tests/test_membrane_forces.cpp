@@ -71,13 +71,19 @@ struct TwoCells {
     Kokkos::deep_copy(mesh.x, x);
     update_geometry(space, mesh, geo, 1e4);
   }
-  // Forces and overstretch flag of the per-term kernels (fused = false) or the fused pass.
-  std::vector<double> forces(bool fused, int* flag = nullptr) {
+  // Forces and overstretch flag of the per-term kernels (fused = false) or the fused pass with the given form
+  // of its edge pass.
+  std::vector<double> forces(bool fused, int* flag = nullptr,
+                             MembraneEdgeKernel kernel = MembraneEdgeKernel::fastest) {
     Vector f("f", mesh.n_nodes);
     Kokkos::deep_copy(overstretched, -1);
+    // The hinge scratch is written by either path: start from NaN, so that what a pass leaves out shows.
+    Kokkos::deep_copy(hinges.hinge_grad, std::nan(""));
+    Kokkos::deep_copy(hinges.hinge_moment, std::nan(""));
+    Kokkos::deep_copy(hinges.hinge_cos_delta, std::nan(""));
     if (fused) {
       add_membrane_forces(space, mesh, geo, bonds, bond_params.table(), hinges, k_b.table(), area,
-                          k_a.table(), k_d.table(), volume, k_v.table(), scratch, f, overstretched);
+                          k_a.table(), k_d.table(), volume, k_v.table(), scratch, f, overstretched, kernel);
     } else {
       add_fene_pow_forces(space, mesh, bonds, bond_params.table(), f, overstretched);
       add_bending_forces(space, mesh, hinges, k_b.table(), f);
@@ -102,9 +108,14 @@ double max_abs(const std::vector<double>& v) {
   for (double a : v) m = std::max(m, std::abs(a));
   return m;
 }
+// Infinite where either side is not finite (a slot or scratch entry a pass left out stays NaN).
 double max_diff(const std::vector<double>& a, const std::vector<double>& b) {
   double m = 0;
-  for (std::size_t k = 0; k < a.size(); ++k) m = std::max(m, std::abs(a[k] - b[k]));
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    const double d = std::abs(a[k] - b[k]);
+    if (!std::isfinite(d)) return HUGE_VAL;
+    m = std::max(m, d);
+  }
   return m;
 }
 
@@ -122,13 +133,21 @@ TEST(MembraneForces, BondsAndHingesAreNumberedAlike) {
   EXPECT_TRUE(bonds_match_hinges(s.mesh));
 }
 
+// The three forms of the edge pass: the build's fastest (the vector pass on GCC / Clang host builds), the
+// portable lanes, one edge per work item.
+const MembraneEdgeKernel kEdgeKernels[] = {MembraneEdgeKernel::fastest, MembraneEdgeKernel::lanes,
+                                           MembraneEdgeKernel::one_edge};
+
 TEST(MembraneForces, FusedPassEqualsThePerTermKernels) {
   TwoCells s;
   const std::vector<double> per_term = s.forces(false), scratch_per_term = s.hinge_scratch();
-  const std::vector<double> fused = s.forces(true), scratch_fused = s.hinge_scratch();
   ASSERT_GT(max_abs(per_term), 0);
-  EXPECT_LE(max_diff(per_term, fused), 1e-11 * max_abs(per_term));
-  EXPECT_LE(max_diff(scratch_per_term, scratch_fused), 1e-11 * max_abs(scratch_per_term));
+  for (const MembraneEdgeKernel kernel : kEdgeKernels) {
+    const std::vector<double> fused = s.forces(true, nullptr, kernel), scratch_fused = s.hinge_scratch();
+    EXPECT_LE(max_diff(per_term, fused), 1e-11 * max_abs(per_term)) << "edge kernel " << int(kernel);
+    EXPECT_LE(max_diff(scratch_per_term, scratch_fused), 1e-11 * max_abs(scratch_per_term))
+        << "edge kernel " << int(kernel);
+  }
   // Each term alone also matches (a term dropped or doubled by the fused pass would show here, even where
   // another term dominates the sum): switch all but one off by zeroing its constants.
   const PerCell<double, Mem> zero{{0.0, 0.0}};
@@ -139,9 +158,11 @@ TEST(MembraneForces, FusedPassEqualsThePerTermKernels) {
     if (term != 3) t.k_v = zero;
     if (term != 0)
       t.bond_params = PerCell<FenePowParams, Mem>({FenePowParams{0.0, 2.05}, FenePowParams{0.0, 2.6}});
-    const std::vector<double> a = t.forces(false), b = t.forces(true);
+    const std::vector<double> a = t.forces(false);
     ASSERT_GT(max_abs(a), 0) << "term " << term;
-    EXPECT_LE(max_diff(a, b), 1e-11 * max_abs(a)) << "term " << term;
+    for (const MembraneEdgeKernel kernel : kEdgeKernels)
+      EXPECT_LE(max_diff(a, t.forces(true, nullptr, kernel)), 1e-11 * max_abs(a))
+          << "term " << term << ", edge kernel " << int(kernel);
   }
 }
 
@@ -150,16 +171,20 @@ TEST(MembraneForces, BatchesAcrossCellsAndAnUnevenLastBatchEqualThePerTermKernel
   ASSERT_EQ(s.mesh.n_hinges, 630);  // not a multiple of 8: the last batch overlaps
   set_uneven_constants(s);
   const std::vector<double> per_term = s.forces(false), scratch_per_term = s.hinge_scratch();
-  const std::vector<double> fused = s.forces(true), scratch_fused = s.hinge_scratch();
   ASSERT_GT(max_abs(per_term), 0);
-  EXPECT_LE(max_diff(per_term, fused), 1e-11 * max_abs(per_term));
-  EXPECT_LE(max_diff(scratch_per_term, scratch_fused), 1e-11 * max_abs(scratch_per_term));
-  // Every cell's own forces, so that a small cell's error does not hide under a large cell's forces.
-  const std::vector<int> begin = s.mesh.host_cell_node_begin;
-  for (int c = 0; c < 3; ++c) {
-    const auto from = per_term.begin() + 3 * begin[c], to = per_term.begin() + 3 * begin[c + 1];
-    const std::vector<double> a(from, to), b(fused.begin() + 3 * begin[c], fused.begin() + 3 * begin[c + 1]);
-    EXPECT_LE(max_diff(a, b), 1e-11 * max_abs(a)) << "cell " << c;
+  for (const MembraneEdgeKernel kernel : kEdgeKernels) {
+    const std::vector<double> fused = s.forces(true, nullptr, kernel), scratch_fused = s.hinge_scratch();
+    EXPECT_LE(max_diff(per_term, fused), 1e-11 * max_abs(per_term)) << "edge kernel " << int(kernel);
+    EXPECT_LE(max_diff(scratch_per_term, scratch_fused), 1e-11 * max_abs(scratch_per_term))
+        << "edge kernel " << int(kernel);
+    // Every cell's own forces, so that a small cell's error does not hide under a large cell's forces.
+    const std::vector<int> begin = s.mesh.host_cell_node_begin;
+    for (int c = 0; c < 3; ++c) {
+      const auto from = per_term.begin() + 3 * begin[c], to = per_term.begin() + 3 * begin[c + 1];
+      const std::vector<double> a(from, to),
+          b(fused.begin() + 3 * begin[c], fused.begin() + 3 * begin[c + 1]);
+      EXPECT_LE(max_diff(a, b), 1e-11 * max_abs(a)) << "cell " << c << ", edge kernel " << int(kernel);
+    }
   }
 }
 
@@ -171,12 +196,15 @@ TEST(MembraneForces, OverstretchedBondInTheOverlappingLastBatchIsFlagged) {
   auto rest = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), s.bonds.rest_length);
   rest(627) *= 0.1;
   Kokkos::deep_copy(s.bonds.rest_length, rest);
-  int flag_fused = -2, flag_terms = -2;
-  const std::vector<double> fused = s.forces(true, &flag_fused);
+  int flag_terms = -2;
   s.forces(false, &flag_terms);
-  EXPECT_EQ(flag_fused, 627);
   EXPECT_EQ(flag_terms, 627);
-  for (double f : fused) EXPECT_TRUE(std::isfinite(f));
+  for (const MembraneEdgeKernel kernel : kEdgeKernels) {
+    int flag_fused = -2;
+    const std::vector<double> fused = s.forces(true, &flag_fused, kernel);
+    EXPECT_EQ(flag_fused, 627) << "edge kernel " << int(kernel);
+    for (double f : fused) EXPECT_TRUE(std::isfinite(f));
+  }
 }
 
 TEST(MembraneForces, OverstretchedBondIsFlaggedLikeThePerTermKernel) {
@@ -190,14 +218,16 @@ TEST(MembraneForces, OverstretchedBondIsFlaggedLikeThePerTermKernel) {
   x(node, 2) += 3e-6;
   Kokkos::deep_copy(s.mesh.x, x);
   update_geometry(s.space, s.mesh, s.geo, 1e4);
-  const std::vector<double> fused = s.forces(true, &flag_fused);
   s.forces(false, &flag_terms);
-  ASSERT_GE(flag_fused, 0);
   ASSERT_GE(flag_terms, 0);
   const auto bond = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), s.mesh.bond);
-  EXPECT_TRUE(bond(flag_fused, 0) == node || bond(flag_fused, 1) == node) << "bond " << flag_fused;
   EXPECT_TRUE(bond(flag_terms, 0) == node || bond(flag_terms, 1) == node) << "bond " << flag_terms;
-  for (double f : fused) EXPECT_TRUE(std::isfinite(f));  // the bad bonds add nothing, and no NaN
+  for (const MembraneEdgeKernel kernel : kEdgeKernels) {
+    const std::vector<double> fused = s.forces(true, &flag_fused, kernel);
+    ASSERT_GE(flag_fused, 0) << "edge kernel " << int(kernel);
+    EXPECT_TRUE(bond(flag_fused, 0) == node || bond(flag_fused, 1) == node) << "bond " << flag_fused;
+    for (double f : fused) EXPECT_TRUE(std::isfinite(f));  // the bad bonds add nothing, and no NaN
+  }
 }
 
 }  // namespace

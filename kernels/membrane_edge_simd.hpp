@@ -1,0 +1,253 @@
+#pragma once
+// The membrane edge pass (kernels/membrane_edge_pass.hpp, docs/model/membrane_pass.md "Session 21") written
+// with explicit 8-wide vectors (GCC / Clang vector extensions) for host execution spaces: the physics and the
+// order of the operations of EdgePass<8>, equal to it to rounding (the compiler may contract multiply-adds
+// differently). What differs is how the lanes are built and emptied, all in registers:
+//  - positions: one 4-vector load per hinge node from a padded copy of x ([node][4], made per call), then an
+//    8 x 4 transpose per role (the auto-vectorised lanes went through stack arrays: scalar loads and stores,
+//    then vector loads, and the indices back and forth between vector and scalar registers);
+//  - the hinge gradients ([edge][12]) and the slots ([slot][4]: x, y, z, unused) stored as one 4-vector per
+//    (edge, role) after a 4 x 8 transpose, instead of 24 scalar stores per edge;
+//  - the node gather adds one 4-vector per slot.
+// Selected by add_membrane_forces() where MembraneLanes is 8; MembraneEdgeKernel::lanes runs EdgePass<8>.
+//
+// Host compilers only: not under nvcc / hipcc / SYCL (there the host spaces run EdgePass<8>).
+#if defined(__GNUC__) && !defined(__CUDACC__) && !defined(__HIPCC__) && !defined(SYCL_LANGUAGE_VERSION)
+#define DCM_MEMBRANE_EDGE_SIMD 1
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
+
+#include <Kokkos_Core.hpp>
+
+#include "kernels/membrane_edge_pass.hpp"
+
+namespace dcm {
+namespace membrane_detail {
+
+using vd8 = double __attribute__((vector_size(64), aligned(64)));
+using vm8 = long long __attribute__((vector_size(64), aligned(64)));
+using vd4 = double __attribute__((vector_size(32), aligned(32)));
+
+// Vectors go by reference: by value, a 64-byte vector changes the calling convention with the ISA (-Wpsabi).
+KOKKOS_FORCEINLINE_FUNCTION void sqrt8(const vd8& a, vd8& r) {
+#if defined(__AVX512F__)
+  r = reinterpret_cast<vd8>(
+      _mm512_mask_sqrt_pd(reinterpret_cast<__m512d>(a), 0xFF, reinterpret_cast<__m512d>(a)));
+#elif defined(__AVX__)
+  const __m256d lo = _mm256_sqrt_pd(_mm256_setr_pd(a[0], a[1], a[2], a[3]));
+  const __m256d hi = _mm256_sqrt_pd(_mm256_setr_pd(a[4], a[5], a[6], a[7]));
+  r = vd8{lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]};
+#else
+  for (int l = 0; l < 8; ++l) r[l] = __builtin_sqrt(a[l]);
+#endif
+}
+
+// {p[idx[0]], p[idx[s]], ..., p[idx[7 s]]} and {p[0], p[s], ..., p[7 s]}.
+KOKKOS_FORCEINLINE_FUNCTION void load8_indexed(const double* p, const int* idx, const int s, vd8& r) {
+  r = vd8{p[idx[0]],     p[idx[s]],     p[idx[2 * s]], p[idx[3 * s]],
+          p[idx[4 * s]], p[idx[5 * s]], p[idx[6 * s]], p[idx[7 * s]]};
+}
+KOKKOS_FORCEINLINE_FUNCTION void load8_strided(const double* p, const int s, vd8& r) {
+  r = vd8{p[0], p[s], p[2 * s], p[3 * s], p[4 * s], p[5 * s], p[6 * s], p[7 * s]};
+}
+
+// r[l] = (a[l], b[l], c[l], d[l]) for the eight lanes l.
+KOKKOS_FORCEINLINE_FUNCTION void transpose4x8(const vd8& a, const vd8& b, const vd8& c, const vd8& d,
+                                              vd4* r) {
+  const vd8 ab_lo = __builtin_shufflevector(a, b, 0, 8, 1, 9, 2, 10, 3, 11);  // a0 b0 a1 b1 a2 b2 a3 b3
+  const vd8 ab_hi = __builtin_shufflevector(a, b, 4, 12, 5, 13, 6, 14, 7, 15);
+  const vd8 cd_lo = __builtin_shufflevector(c, d, 0, 8, 1, 9, 2, 10, 3, 11);
+  const vd8 cd_hi = __builtin_shufflevector(c, d, 4, 12, 5, 13, 6, 14, 7, 15);
+  r[0] = __builtin_shufflevector(ab_lo, cd_lo, 0, 1, 8, 9);
+  r[1] = __builtin_shufflevector(ab_lo, cd_lo, 2, 3, 10, 11);
+  r[2] = __builtin_shufflevector(ab_lo, cd_lo, 4, 5, 12, 13);
+  r[3] = __builtin_shufflevector(ab_lo, cd_lo, 6, 7, 14, 15);
+  r[4] = __builtin_shufflevector(ab_hi, cd_hi, 0, 1, 8, 9);
+  r[5] = __builtin_shufflevector(ab_hi, cd_hi, 2, 3, 10, 11);
+  r[6] = __builtin_shufflevector(ab_hi, cd_hi, 4, 5, 12, 13);
+  r[7] = __builtin_shufflevector(ab_hi, cd_hi, 6, 7, 14, 15);
+}
+
+struct EdgePassSimd8 : EdgePassArgs {
+  static constexpr int W = 8;
+  const double* x4;  // positions [node][4] (x, y, z, unused): a padded copy of x, one 4-vector per node
+
+  // The three coordinates of the eight nodes idx[0], idx[4], ..., idx[28] (one role of a batch), from the
+  // padded copy of the positions: one 4-vector load per node, then a transpose.
+  KOKKOS_FORCEINLINE_FUNCTION void load_role(const int* idx, vd8 (&r)[3]) const {
+    vd4 q[W];
+    for (int l = 0; l < W; ++l) __builtin_memcpy(&q[l], x4 + 4 * static_cast<long>(idx[4 * l]), sizeof(vd4));
+    const vd8 c01 = __builtin_shufflevector(q[0], q[1], 0, 1, 2, 3, 4, 5, 6, 7);  // x0 y0 z0 w0 x1 y1 z1 w1
+    const vd8 c23 = __builtin_shufflevector(q[2], q[3], 0, 1, 2, 3, 4, 5, 6, 7);
+    const vd8 c45 = __builtin_shufflevector(q[4], q[5], 0, 1, 2, 3, 4, 5, 6, 7);
+    const vd8 c67 = __builtin_shufflevector(q[6], q[7], 0, 1, 2, 3, 4, 5, 6, 7);
+    const vd8 xy03 = __builtin_shufflevector(c01, c23, 0, 4, 8, 12, 1, 5, 9, 13);  // x0..x3 y0..y3
+    const vd8 xy47 = __builtin_shufflevector(c45, c67, 0, 4, 8, 12, 1, 5, 9, 13);
+    const vd8 z03 = __builtin_shufflevector(c01, c23, 2, 6, 10, 14, 3, 7, 11, 15);  // z0..z3 w0..w3
+    const vd8 z47 = __builtin_shufflevector(c45, c67, 2, 6, 10, 14, 3, 7, 11, 15);
+    r[0] = __builtin_shufflevector(xy03, xy47, 0, 1, 2, 3, 8, 9, 10, 11);
+    r[1] = __builtin_shufflevector(xy03, xy47, 4, 5, 6, 7, 12, 13, 14, 15);
+    r[2] = __builtin_shufflevector(z03, z47, 0, 1, 2, 3, 8, 9, 10, 11);
+  }
+
+  KOKKOS_INLINE_FUNCTION void operator()(const int batch) const {
+    const int start = batch * W;
+    const int base = start + W <= n ? start : n - W, first = start - base;
+    const int* h = hinge + 4 * base;
+    vd8 p[4][3];  // role, coordinate; one role's eight nodes at a time
+    load_role(h + 0, p[0]);
+    load_role(h + 1, p[1]);
+    load_role(h + 2, p[2]);
+    load_role(h + 3, p[3]);
+    const vd8 *xi = p[0], *xj = p[1], *xk = p[2], *xl = p[3];
+    vd8 dr, cr, sr, a01, a02;
+    __builtin_memcpy(&dr, rest_length + base, sizeof dr);  // unaligned
+    load8_strided(rest_trig + 2 * base, 2, cr);
+    load8_strided(rest_trig + 2 * base + 1, 2, sr);
+    load8_indexed(rest_area, tri2 + 2 * base, 2, a01);
+    load8_indexed(rest_area, tri2 + 2 * base + 1, 2, a02);
+    vd8 kb, ks, xm2, kcf, ka, global, vol;
+    const int c_first = edge_cell[base], c_last = edge_cell[base + W - 1];
+    if (c_first == c_last) {
+      const double* k = cell_constants + K * c_first;
+      kb = vd8{} + k[0];
+      ks = vd8{} + k[1];
+      xm2 = vd8{} + k[2];
+      kcf = vd8{} + k[3];
+      ka = vd8{} + k[4];
+      global = vd8{} + k[5];
+      vol = vd8{} + k[6];
+    } else {
+      for (int l = 0; l < W; ++l) {
+        const double* k = cell_constants + K * edge_cell[base + l];
+        kb[l] = k[0];
+        ks[l] = k[1];
+        xm2[l] = k[2];
+        kcf[l] = k[3];
+        ka[l] = k[4];
+        global[l] = k[5];
+        vol[l] = k[6];
+      }
+    }
+    const vd8 ex = xj[0] - xi[0], ey = xj[1] - xi[1], ez = xj[2] - xi[2];  // e = x_j - x_i
+    const vd8 ax = xk[0] - xi[0], ay = xk[1] - xi[1], az = xk[2] - xi[2];  // x_k - x_i
+    const vd8 bx = xl[0] - xj[0], by = xl[1] - xj[1], bz = xl[2] - xj[2];  // x_l - x_j
+    const vd8 n1x = ey * az - ez * ay, n1y = ez * ax - ex * az, n1z = ex * ay - ey * ax;
+    const vd8 n2x = by * ez - bz * ey, n2y = bz * ex - bx * ez, n2z = bx * ey - by * ex;
+    const vd8 zero = vd8{}, one = vd8{} + 1.0;
+    const vd8 e2 = ex * ex + ey * ey + ez * ez;
+    const vd8 n1_2 = n1x * n1x + n1y * n1y + n1z * n1z, n2_2 = n2x * n2x + n2y * n2y + n2z * n2z;
+    const vd8 d_rest = dr, d_max2 = xm2 * d_rest * d_rest;
+    const vm8 bond_ok = (e2 > zero) & (e2 < d_max2);
+    const vm8 hinge_ok = (e2 > zero) & (n1_2 > zero) & (n2_2 > zero);
+    const vd8 e2s = e2 > zero ? e2 : one, gap = bond_ok ? d_max2 - e2 : one;
+    const vd8 n1s = n1_2 > zero ? n1_2 : one, n2s = n2_2 > zero ? n2_2 : one;
+    vd8 len, r1, r2;
+    sqrt8(e2s, len);
+    sqrt8(n1s, r1);
+    sqrt8(n2s, r2);
+    const vd8 q = 1.0 / (len * gap * r1 * r2);
+    const vd8 inv_len = q * gap * r1 * r2, inv_gap = q * len * r1 * r2;
+    const vd8 inv_r1 = q * len * gap * r2, inv_r2 = q * len * gap * r1;
+    const vd8 inv_n1 = inv_r1 * inv_r1, inv_n2 = inv_r2 * inv_r2;
+    const vd8 k_c = kcf * d_rest * d_rest * d_rest;
+    const vd8 u = bond_ok ? ks * d_max2 * inv_gap - k_c * inv_len * inv_len * inv_len : zero;
+    const vd8 inv = inv_r1 * inv_r2 * inv_len;
+    const vd8 c = hinge_ok ? len * (n1x * n2x + n1y * n2y + n1z * n2z) * inv : one;
+    const vd8 s =
+        hinge_ok
+            ? ((n1y * n2z - n1z * n2y) * ex + (n1z * n2x - n1x * n2z) * ey + (n1x * n2y - n1y * n2x) * ez) *
+                  inv
+            : zero;
+    const vd8 gk = hinge_ok ? -len * inv_n1 : zero, gl = hinge_ok ? -len * inv_n2 : zero;
+    const vd8 inv_e2 = inv_len * inv_len;
+    const vd8 ak = (ax * ex + ay * ey + az * ez) * inv_e2;
+    const vd8 al = (bx * ex + by * ey + bz * ez) * inv_e2 + 1.0;
+    const vd8 mm = -kb * (s * cr - c * sr);
+    const vd8 cd = c * cr + s * sr;
+    const vd8 h1 = -0.5 * (ka * (0.5 * r1 - a01) / a01 + global) * inv_r1;
+    const vd8 h2 = 0.5 * (ka * (0.5 * r2 - a02) / a02 + global) * inv_r2;
+    const vd8 v2 = 0.5 * vol;
+    const vd8 n1v[3] = {n1x, n1y, n1z}, n2v[3] = {n2x, n2y, n2z}, ev[3] = {ex, ey, ez};
+    const vd8 w1[3] = {n1y * ez - n1z * ey, n1z * ex - n1x * ez, n1x * ey - n1y * ex};
+    const vd8 w2[3] = {n2y * ez - n2z * ey, n2z * ex - n2x * ez, n2x * ey - n2y * ex};
+    vd8 g[4][3], o[4][3];
+    for (int d = 0; d < 3; ++d) {
+      const vd8 g2 = gk * n1v[d], g3 = gl * n2v[d];
+      const vd8 g0 = (ak - 1.0) * g2 + (al - 1.0) * g3, g1 = -ak * g2 - al * g3;
+      g[0][d] = g0;
+      g[1][d] = g1;
+      g[2][d] = g2;
+      g[3][d] = g3;
+      o[0][d] = mm * g0 + u * ev[d];
+      o[1][d] = mm * g1 - u * ev[d];
+      o[2][d] = mm * g2 + (h1 * w1[d] + v2 * n1v[d]);
+      o[3][d] = mm * g3 + (h2 * w2[d] + v2 * n2v[d]);
+    }
+    long long any_bad = 0;  // a bond at or past d_max, or NaN (the lanes' test above)
+    for (int l = 0; l < W; ++l) any_bad |= ~bond_ok[l];
+    if (any_bad)
+      for (int l = first; l < W; ++l)
+        if (!bond_ok[l]) Kokkos::atomic_compare_exchange(overstretched, -1, base + l);
+    if (first == 0)  // a whole batch: constant lane bounds, unrolled
+      store(base, 0, mm, cd, g, o);
+    else
+      store(base, first, mm, cd, g, o);
+  }
+
+  // moment and cos_delta as vectors; the hinge gradients ([edge][12]) and the slots ([slot][4]: x, y, z, 0)
+  // through in-register transposes, one 4-vector per (edge, role). Lanes from `first` on.
+  KOKKOS_FORCEINLINE_FUNCTION void store(const int base, const int first, const vd8& mm, const vd8& cd,
+                                         const vd8 (&g)[4][3], const vd8 (&o)[4][3]) const {
+    // Local copies: the stores below are byte copies, which may alias this functor's members.
+    double* const grad_p = grad + 12 * base;
+    double* const out_p = out;
+    const int* const slot_p = slot + 4 * base;
+    if (first == 0) {
+      __builtin_memcpy(moment + base, &mm, sizeof mm);
+      __builtin_memcpy(cos_delta + base, &cd, sizeof cd);
+    } else {
+      for (int l = first; l < W; ++l) {
+        moment[base + l] = mm[l];
+        cos_delta[base + l] = cd[l];
+      }
+    }
+    vd4 t[W];
+    transpose4x8(g[0][0], g[0][1], g[0][2], g[1][0], t);
+    for (int l = first; l < W; ++l) __builtin_memcpy(grad_p + 12 * l, &t[l], sizeof(vd4));
+    transpose4x8(g[1][1], g[1][2], g[2][0], g[2][1], t);
+    for (int l = first; l < W; ++l) __builtin_memcpy(grad_p + 12 * l + 4, &t[l], sizeof(vd4));
+    transpose4x8(g[2][2], g[3][0], g[3][1], g[3][2], t);
+    for (int l = first; l < W; ++l) __builtin_memcpy(grad_p + 12 * l + 8, &t[l], sizeof(vd4));
+    const vd8 pad = vd8{};
+    for (int v = 0; v < 4; ++v) {
+      transpose4x8(o[v][0], o[v][1], o[v][2], pad, t);
+      for (int l = first; l < W; ++l) __builtin_memcpy(out_p + 4 * slot_p[4 * l + v], &t[l], sizeof(vd4));
+    }
+  }
+};
+
+// The node gather (kernels/membrane_forces.hpp, pass 2) on 4-vectors: force(i) += the sum of node i's
+// slots, in the same order as the scalar gather (so the same bits).
+struct GatherSimd {
+  const int* offsets;  // [node + 1]
+  const double* in;    // [slot][4]
+  double* force;       // [node][3]
+  KOKKOS_INLINE_FUNCTION void operator()(const int i) const {
+    vd4 sum = vd4{};
+    for (int s = offsets[i]; s < offsets[i + 1]; ++s) {
+      vd4 v;
+      __builtin_memcpy(&v, in + 4 * s, sizeof v);
+      sum += v;
+    }
+    double* f = force + 3 * i;
+    f[0] += sum[0];
+    f[1] += sum[1];
+    f[2] += sum[2];
+  }
+};
+
+}  // namespace membrane_detail
+}  // namespace dcm
+#endif
