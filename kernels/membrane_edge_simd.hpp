@@ -11,8 +11,10 @@
 //  - the node gather adds one 4-vector per slot.
 // Selected by add_membrane_forces() where MembraneLanes is 8; MembraneEdgeKernel::lanes runs EdgePass<8>.
 //
-// Host compilers only: not under nvcc / hipcc / SYCL (there the host spaces run EdgePass<8>).
-#if defined(__GNUC__) && !defined(__CUDACC__) && !defined(__HIPCC__) && !defined(SYCL_LANGUAGE_VERSION)
+// Host compilers only: not under nvcc / hipcc / SYCL (there the host spaces run EdgePass<8>), nor with
+// -DDCM_NO_MEMBRANE_SIMD (ctest unit.membrane_portable builds the membrane tests so).
+#if defined(__GNUC__) && !defined(__CUDACC__) && !defined(__HIPCC__) && !defined(SYCL_LANGUAGE_VERSION) && \
+    !defined(DCM_NO_MEMBRANE_SIMD)
 #define DCM_MEMBRANE_EDGE_SIMD 1
 #if defined(__AVX__)
 #include <immintrin.h>

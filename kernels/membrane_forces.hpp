@@ -14,16 +14,17 @@
 //    all from one evaluation that shares |x_j - x_i|, the triangles' normals (e x a, b x e: twice the
 //    areas) and the reciprocals (one division per edge). The hinge's gradient, -M and cos(theta - theta*)
 //    go into HingeRest as add_bending_forces() leaves them (the implicit bending stiffness reads them).
-// 2. Node gather. Pass 1 writes each hinge node's share (3 doubles) into a slot of that node's contiguous
-//    range of the scratch (fill_membrane_slots()); the gather sums the range: no atomics, deterministic,
-//    and no scattered reads (the scattered accesses are the pass's stores).
+// 2. Node gather. Pass 1 writes each hinge node's share (x, y, z and an unused fourth double) into a slot of
+//    that node's contiguous range of the scratch (fill_membrane_slots()); the gather sums the range: no
+//    atomics, deterministic, and no scattered reads (the scattered accesses are the pass's stores).
 //
-// Pass 1 works on MembraneLanes consecutive edges per work item, loaded into small local arrays and
-// computed in straight-line loops over the lanes, which the host compiler turns into SIMD instructions;
-// on a GPU a work item is one edge (MembraneLanes = 1). The constants of each cell (k_b, k_s, x_max,
-// k_a and the global area and volume factors) are gathered into one row per cell before the pass; a
-// batch whose edges share a cell reads one row. Where the edge count is not a multiple of the lanes, the
-// last batch overlaps the one before it and stores only its own edges.
+// Pass 1 works on MembraneLanes consecutive edges per work item: on the host 8, with explicit vectors where
+// the compiler is GCC or Clang (kernels/membrane_edge_simd.hpp) and otherwise in straight-line loops over
+// the lanes that the compiler vectorises (kernels/membrane_edge_pass.hpp); on a GPU a work item is one edge
+// (MembraneLanes = 1). MembraneEdgeKernel picks another form (the tests run all three). The constants of each
+// cell (k_b, k_s, x_max, k_a and the global area and volume factors) are gathered into one row per cell
+// before the pass; a batch whose edges share a cell reads one row. Where the edge count is not a multiple of
+// the lanes, the last batch overlaps the one before it and stores only its own edges.
 //
 // Expectations (tests/test_membrane_forces.cpp): the same forces, hinge scratch and overstretch flag as the
 // per-term kernels (to rounding), on meshes with several cells and per-cell constants.
@@ -213,12 +214,9 @@ void add_membrane_forces(const ExecutionSpace& space, const MeshBuffers<MemorySp
   };
   constexpr int W = MembraneLanes<ExecutionSpace>::value;
   const bool lanes = n >= W && kernel != MembraneEdgeKernel::one_edge;
+  bool done = false;
 #if defined(DCM_MEMBRANE_EDGE_SIMD)
-  constexpr bool host_simd = W == 8 && MembraneScratch<MemorySpace>::kHostSimd;
-#else
-  constexpr bool host_simd = false;
-#endif
-  if constexpr (host_simd) {
+  if constexpr (W == 8 && MembraneScratch<MemorySpace>::kHostSimd) {
     if (lanes && kernel == MembraneEdgeKernel::fastest) {
       // The padded copy of the positions that the vector pass loads one 4-vector per node from.
       const auto x = mesh.x;
@@ -234,19 +232,17 @@ void add_membrane_forces(const ExecutionSpace& space, const MeshBuffers<MemorySp
       static_cast<membrane_detail::EdgePassArgs&>(pass) = args;
       pass.x4 = x4.data();
       run(pass);
-    } else if (lanes) {
-      run(membrane_detail::EdgePass<W>{args});
-    } else {
-      run(membrane_detail::EdgePass<1>{args});
+      done = true;
     }
-  } else if (lanes) {
-    run(membrane_detail::EdgePass<W>{args});
-  } else {
-    run(membrane_detail::EdgePass<1>{args});
   }
-  // 2. Node gather: the node's slots, contiguous.
+#endif
+  if (!done && lanes)
+    run(membrane_detail::EdgePass<W>{args});
+  else if (!done)
+    run(membrane_detail::EdgePass<1>{args});
+    // 2. Node gather: the node's slots, contiguous.
 #if defined(DCM_MEMBRANE_EDGE_SIMD)
-  if constexpr (host_simd) {
+  if constexpr (W == 8 && MembraneScratch<MemorySpace>::kHostSimd) {
     if (force.stride_0() != 3) throw std::logic_error("add_membrane_forces: the force View is padded");
     const membrane_detail::GatherSimd gather{mesh.node_hinge_offsets.data(), scratch.slot_force.data(),
                                              force.data()};
