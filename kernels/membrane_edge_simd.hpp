@@ -1,8 +1,8 @@
 #pragma once
-// The membrane edge pass (kernels/membrane_edge_pass.hpp, docs/model/membrane_pass.md "Session 21") written
-// with explicit 8-wide vectors (GCC / Clang vector extensions) for host execution spaces: the physics and the
-// order of the operations of EdgePass<8>, equal to it to rounding (the compiler may contract multiply-adds
-// differently). What differs is how the lanes are built and emptied, all in registers:
+// The membrane edge pass (kernels/membrane_edge_pass.hpp, docs/model/membrane_pass.md "Session 21") on
+// explicit 8-wide vectors (GCC / Clang vector extensions) for host execution spaces. The physics is
+// EdgePass's own, edge_forces() instantiated for vectors of eight edges; what differs is how the lanes are
+// built and emptied, all in registers:
 //  - positions: one 4-vector load per hinge node from a padded copy of x ([node][4], made per call), then an
 //    8 x 4 transpose per role (the auto-vectorised lanes went through stack arrays: scalar loads and stores,
 //    then vector loads, and the indices back and forth between vector and scalar registers);
@@ -12,7 +12,7 @@
 // Selected by add_membrane_forces() where MembraneLanes is 8; MembraneEdgeKernel::lanes runs EdgePass<8>.
 //
 // Host compilers only: not under nvcc / hipcc / SYCL (there the host spaces run EdgePass<8>), nor with
-// -DDCM_NO_MEMBRANE_SIMD (ctest unit.membrane_portable builds the membrane tests so).
+// -DDCM_NO_MEMBRANE_SIMD (the ctests portable.MembraneForces.* build the membrane tests so).
 #if defined(__GNUC__) && !defined(__CUDACC__) && !defined(__HIPCC__) && !defined(SYCL_LANGUAGE_VERSION) && \
     !defined(DCM_NO_MEMBRANE_SIMD)
 #define DCM_MEMBRANE_EDGE_SIMD 1
@@ -27,23 +27,25 @@
 namespace dcm {
 namespace membrane_detail {
 
-using vd8 = double __attribute__((vector_size(64), aligned(64)));
-using vm8 = long long __attribute__((vector_size(64), aligned(64)));
-using vd4 = double __attribute__((vector_size(32), aligned(32)));
+using vd8 = double __attribute__((vector_size(64)));
+using vm8 = long long __attribute__((vector_size(64)));
+using vd4 = double __attribute__((vector_size(32)));
 
-// Vectors go by reference: by value, a 64-byte vector changes the calling convention with the ISA (-Wpsabi).
-KOKKOS_FORCEINLINE_FUNCTION void sqrt8(const vd8& a, vd8& r) {
+// The square roots of eight doubles, for edge_forces() (by reference, like ScalarSqrt).
+struct VectorSqrt {
+  KOKKOS_FORCEINLINE_FUNCTION void operator()(const vd8& a, vd8& r) const {
 #if defined(__AVX512F__)
-  r = reinterpret_cast<vd8>(
-      _mm512_mask_sqrt_pd(reinterpret_cast<__m512d>(a), 0xFF, reinterpret_cast<__m512d>(a)));
+    r = reinterpret_cast<vd8>(
+        _mm512_mask_sqrt_pd(reinterpret_cast<__m512d>(a), 0xFF, reinterpret_cast<__m512d>(a)));
 #elif defined(__AVX__)
-  const __m256d lo = _mm256_sqrt_pd(_mm256_setr_pd(a[0], a[1], a[2], a[3]));
-  const __m256d hi = _mm256_sqrt_pd(_mm256_setr_pd(a[4], a[5], a[6], a[7]));
-  r = vd8{lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]};
+    const __m256d lo = _mm256_sqrt_pd(_mm256_setr_pd(a[0], a[1], a[2], a[3]));
+    const __m256d hi = _mm256_sqrt_pd(_mm256_setr_pd(a[4], a[5], a[6], a[7]));
+    r = vd8{lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]};
 #else
-  for (int l = 0; l < 8; ++l) r[l] = __builtin_sqrt(a[l]);
+    for (int l = 0; l < 8; ++l) r[l] = __builtin_sqrt(a[l]);
 #endif
-}
+  }
+};
 
 // {p[idx[0]], p[idx[s]], ..., p[idx[7 s]]} and {p[0], p[s], ..., p[7 s]}.
 KOKKOS_FORCEINLINE_FUNCTION void load8_indexed(const double* p, const int* idx, const int s, vd8& r) {
@@ -102,14 +104,14 @@ struct EdgePassSimd8 : EdgePassArgs {
     load_role(h + 1, p[1]);
     load_role(h + 2, p[2]);
     load_role(h + 3, p[3]);
-    const vd8 *xi = p[0], *xj = p[1], *xk = p[2], *xl = p[3];
-    vd8 dr, cr, sr, a01, a02;
-    __builtin_memcpy(&dr, rest_length + base, sizeof dr);  // unaligned
-    load8_strided(rest_trig + 2 * base, 2, cr);
-    load8_strided(rest_trig + 2 * base + 1, 2, sr);
-    load8_indexed(rest_area, tri2 + 2 * base, 2, a01);
-    load8_indexed(rest_area, tri2 + 2 * base + 1, 2, a02);
-    vd8 kb, ks, xm2, kcf, ka, global, vol;
+    EdgeRestValues<vd8> rest;
+    __builtin_memcpy(&rest.d_rest, rest_length + base, sizeof(vd8));  // unaligned
+    load8_strided(rest_trig + 2 * base, 2, rest.cos_rest);
+    load8_strided(rest_trig + 2 * base + 1, 2, rest.sin_rest);
+    load8_indexed(rest_area, tri2 + 2 * base, 2, rest.area1);
+    load8_indexed(rest_area, tri2 + 2 * base + 1, 2, rest.area2);
+    CellRowValues<vd8> row;
+    auto& [kb, ks, xm2, kcf, ka, global, vol] = row;
     const int c_first = edge_cell[base], c_last = edge_cell[base + W - 1];
     if (c_first == c_last) {
       const double* k = cell_constants + K * c_first;
@@ -132,61 +134,9 @@ struct EdgePassSimd8 : EdgePassArgs {
         vol[l] = k[6];
       }
     }
-    const vd8 ex = xj[0] - xi[0], ey = xj[1] - xi[1], ez = xj[2] - xi[2];  // e = x_j - x_i
-    const vd8 ax = xk[0] - xi[0], ay = xk[1] - xi[1], az = xk[2] - xi[2];  // x_k - x_i
-    const vd8 bx = xl[0] - xj[0], by = xl[1] - xj[1], bz = xl[2] - xj[2];  // x_l - x_j
-    const vd8 n1x = ey * az - ez * ay, n1y = ez * ax - ex * az, n1z = ex * ay - ey * ax;
-    const vd8 n2x = by * ez - bz * ey, n2y = bz * ex - bx * ez, n2z = bx * ey - by * ex;
-    const vd8 zero = vd8{}, one = vd8{} + 1.0;
-    const vd8 e2 = ex * ex + ey * ey + ez * ez;
-    const vd8 n1_2 = n1x * n1x + n1y * n1y + n1z * n1z, n2_2 = n2x * n2x + n2y * n2y + n2z * n2z;
-    const vd8 d_rest = dr, d_max2 = xm2 * d_rest * d_rest;
-    const vm8 bond_ok = (e2 > zero) & (e2 < d_max2);
-    const vm8 hinge_ok = (e2 > zero) & (n1_2 > zero) & (n2_2 > zero);
-    const vd8 e2s = e2 > zero ? e2 : one, gap = bond_ok ? d_max2 - e2 : one;
-    const vd8 n1s = n1_2 > zero ? n1_2 : one, n2s = n2_2 > zero ? n2_2 : one;
-    vd8 len, r1, r2;
-    sqrt8(e2s, len);
-    sqrt8(n1s, r1);
-    sqrt8(n2s, r2);
-    const vd8 q = 1.0 / (len * gap * r1 * r2);
-    const vd8 inv_len = q * gap * r1 * r2, inv_gap = q * len * r1 * r2;
-    const vd8 inv_r1 = q * len * gap * r2, inv_r2 = q * len * gap * r1;
-    const vd8 inv_n1 = inv_r1 * inv_r1, inv_n2 = inv_r2 * inv_r2;
-    const vd8 k_c = kcf * d_rest * d_rest * d_rest;
-    const vd8 u = bond_ok ? ks * d_max2 * inv_gap - k_c * inv_len * inv_len * inv_len : zero;
-    const vd8 inv = inv_r1 * inv_r2 * inv_len;
-    const vd8 c = hinge_ok ? len * (n1x * n2x + n1y * n2y + n1z * n2z) * inv : one;
-    const vd8 s =
-        hinge_ok
-            ? ((n1y * n2z - n1z * n2y) * ex + (n1z * n2x - n1x * n2z) * ey + (n1x * n2y - n1y * n2x) * ez) *
-                  inv
-            : zero;
-    const vd8 gk = hinge_ok ? -len * inv_n1 : zero, gl = hinge_ok ? -len * inv_n2 : zero;
-    const vd8 inv_e2 = inv_len * inv_len;
-    const vd8 ak = (ax * ex + ay * ey + az * ez) * inv_e2;
-    const vd8 al = (bx * ex + by * ey + bz * ez) * inv_e2 + 1.0;
-    const vd8 mm = -kb * (s * cr - c * sr);
-    const vd8 cd = c * cr + s * sr;
-    const vd8 h1 = -0.5 * (ka * (0.5 * r1 - a01) / a01 + global) * inv_r1;
-    const vd8 h2 = 0.5 * (ka * (0.5 * r2 - a02) / a02 + global) * inv_r2;
-    const vd8 v2 = 0.5 * vol;
-    const vd8 n1v[3] = {n1x, n1y, n1z}, n2v[3] = {n2x, n2y, n2z}, ev[3] = {ex, ey, ez};
-    const vd8 w1[3] = {n1y * ez - n1z * ey, n1z * ex - n1x * ez, n1x * ey - n1y * ex};
-    const vd8 w2[3] = {n2y * ez - n2z * ey, n2z * ex - n2x * ez, n2x * ey - n2y * ex};
-    vd8 g[4][3], o[4][3];
-    for (int d = 0; d < 3; ++d) {
-      const vd8 g2 = gk * n1v[d], g3 = gl * n2v[d];
-      const vd8 g0 = (ak - 1.0) * g2 + (al - 1.0) * g3, g1 = -ak * g2 - al * g3;
-      g[0][d] = g0;
-      g[1][d] = g1;
-      g[2][d] = g2;
-      g[3][d] = g3;
-      o[0][d] = mm * g0 + u * ev[d];
-      o[1][d] = mm * g1 - u * ev[d];
-      o[2][d] = mm * g2 + (h1 * w1[d] + v2 * n1v[d]);
-      o[3][d] = mm * g3 + (h2 * w2[d] + v2 * n2v[d]);
-    }
+    vd8 g[4][3], o[4][3], mm, cd;
+    vm8 bond_ok;
+    edge_forces(p, rest, row, VectorSqrt{}, g, o, mm, cd, bond_ok);
     long long any_bad = 0;  // a bond at or past d_max, or NaN (the lanes' test above)
     for (int l = 0; l < W; ++l) any_bad |= ~bond_ok[l];
     if (any_bad)

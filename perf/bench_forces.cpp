@@ -2,7 +2,8 @@
 // (threads: OMP_NUM_THREADS or --kokkos-threads). Rest state: the sphere of radius R; positions: the
 // sphere with every coordinate scaled by a random factor in [0.99, 1.02], so every term does its full work.
 // membrane_terms is the four membrane terms one kernel each (bonds, bending, area, volume), membrane_fused
-// the same forces by kernels/membrane_forces.hpp (the geometry they read is updated once, untimed).
+// (and membrane_fused_portable, with the portable form of its edge pass) the same forces by
+// kernels/membrane_forces.hpp (the geometry they read is updated once, untimed).
 //   build/bin/bench_forces [--benchmark_filter=...]
 // Reported: time per call and ns per node (counter "ns_per_node").
 #include <random>
@@ -87,12 +88,23 @@ void membrane_fused(benchmark::State& s) {
   });
 }
 
+// The same with the portable form of the edge pass (EdgePass<8>: what nvcc's host passes and compilers other
+// than GCC and Clang run; membrane_fused is the explicit-vector pass there, kernels/membrane_edge_simd.hpp).
+void membrane_fused_portable(benchmark::State& s) {
+  run(s, [](const Exec& e, Fixture& f) {
+    add_membrane_forces(e, f.mesh, f.geo, f.bonds, FenePowParams{}, f.hinges, 2.4e-19, f.area_rest, 6e-3,
+                        6e-3, f.volume_rest, 1e4, f.scratch, f.force, f.overstretched,
+                        MembraneEdgeKernel::lanes);
+  });
+}
+
 #define DCM_MESHES DenseRange(3, 6, 1)->Unit(benchmark::kMicrosecond)
 BENCHMARK(fene_pow)->DCM_MESHES;
 BENCHMARK(bending)->DCM_MESHES;
 BENCHMARK(bending_per_node)->DCM_MESHES;
 BENCHMARK(membrane_terms)->DCM_MESHES;
 BENCHMARK(membrane_fused)->DCM_MESHES;
+BENCHMARK(membrane_fused_portable)->DCM_MESHES;
 
 }  // namespace
 }  // namespace dcm
