@@ -128,6 +128,26 @@ void set_uneven_constants(TwoCells& s) {
   s.k_v = PerCell<double, Mem>({1e4, 3e3, 5e3});
 }
 
+// The build's form of the edge pass: GCC and Clang host builds compile the vector pass (a broken guard in
+// kernels/membrane_edge_simd.hpp would silently fall back to the portable one: slower, and no test would
+// fail); -DDCM_NO_MEMBRANE_SIMD, nvcc and hipcc the portable one.
+TEST(MembraneForces, TheBuildHasTheExpectedFormOfTheEdgePass) {
+#if defined(__GNUC__) && !defined(__CUDACC__) && !defined(__HIPCC__) && !defined(SYCL_LANGUAGE_VERSION) && \
+    !defined(DCM_NO_MEMBRANE_SIMD)
+  constexpr bool expect_vector_pass = true;
+#else
+  constexpr bool expect_vector_pass = false;
+#endif
+#if defined(DCM_MEMBRANE_EDGE_SIMD)
+  constexpr bool has_vector_pass = true;
+#else
+  constexpr bool has_vector_pass = false;
+#endif
+  EXPECT_EQ(has_vector_pass, expect_vector_pass);
+  constexpr bool host_memory = Kokkos::SpaceAccessibility<Kokkos::HostSpace, Mem>::accessible;
+  EXPECT_EQ(MembraneScratch<Mem>::kHostSimd, has_vector_pass && host_memory);
+}
+
 TEST(MembraneForces, BondsAndHingesAreNumberedAlike) {
   TwoCells s;
   EXPECT_TRUE(bonds_match_hinges(s.mesh));
