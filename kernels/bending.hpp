@@ -175,7 +175,7 @@ void add_bending_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpa
       KOKKOS_LAMBDA(const int i) {
         double f0 = 0, f1 = 0, f2 = 0;
         for (int s = offsets(i); s < offsets(i + 1); ++s) {
-          const int h = roles(s) / 4, a = roles(s) % 4;
+          const int h = roles(s) >> 2, a = roles(s) & 3;  // 4 h + role, non-negative
           const double m = moment(h);
           f0 += m * grad(h, a, 0);
           f1 += m * grad(h, a, 1);
@@ -204,7 +204,7 @@ void add_bending_forces_per_node(const ExecutionSpace& space, const MeshBuffers<
         const double kb = cell_value(k_b, node_cell(i));
         Real3 sum{0, 0, 0};
         for (int s = offsets(i); s < offsets(i + 1); ++s) {
-          const int h = roles(s) / 4, a = roles(s) % 4;
+          const int h = roles(s) >> 2, a = roles(s) & 3;  // 4 h + role, non-negative
           Real3 f[4];
           hinge_bending_forces(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
                                load3(x, hinge(h, 3)), rest_trig(h, 0), rest_trig(h, 1), kb, f);

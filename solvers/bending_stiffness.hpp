@@ -76,7 +76,7 @@ void apply_bending_stiffness(const ExecutionSpace& space, const MeshBuffers<Memo
         if (skipped(active, node_cell(i))) return;
         double o0 = 0, o1 = 0, o2 = 0;
         for (int k = offsets(i); k < offsets(i + 1); ++k) {
-          const int h = roles(k) / 4, a = roles(k) % 4;
+          const int h = roles(k) >> 2, a = roles(k) & 3;  // 4 h + role, non-negative
           o0 += s(h) * g(h, a, 0);
           o1 += s(h) * g(h, a, 1);
           o2 += s(h) * g(h, a, 2);

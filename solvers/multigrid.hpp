@@ -405,7 +405,7 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
             double blk[6];
             for (int k = 0; k < 6; ++k) blk[k] = op_val(s, k);
             for (int q = bend_off(s); q < bend_off(s + 1); ++q) {
-              const int h = bend(q) / 16, ra = bend(q) / 4 % 4, rb = bend(q) % 4;
+              const int h = bend(q) >> 4, ra = (bend(q) >> 2) & 3, rb = bend(q) & 3;  // 16 h + 4 a + b
               add_dashpot_block(Real3{axis(h, 0), axis(h, 1), axis(h, 2)}, axis(h, 3 + ra) * axis(h, 3 + rb),
                                 0.0, 1.0, blk);  // s α_a α_b N̂N̂ᵀ
             }
