@@ -88,7 +88,7 @@ struct Multigrid {
   int n_cells = 0;
   View<int*> fine_slot_bond;  // level 0: the bond of each off-diagonal slot, −1 on the diagonal
   // Level 0: per slot (i, j) the triangle corners (t, c_i, c_j) with tri(t, c_i) = i, tri(t, c_j) = j, packed
-  // as 9 t + 3 c_i + c_j, in the order of i's triangle corners (the implicit tension blocks; topology only).
+  // as 16 t + 4 c_i + c_j, in the order of i's triangle corners (the implicit tension blocks; topology only).
   View<int*> fine_slot_tension_offsets, fine_slot_tension;
   // Bending in the preconditioner (settings.bending not off, a mesh with hinges): per
   // slot (i, j) the hinge roles (h, a, b) with hinge(h, a) = i, hinge(h, b) = j, packed as 16 h + 4 a + b, in
@@ -240,7 +240,7 @@ Multigrid<MemorySpace> make_multigrid(const std::vector<HostCell>& cells,
         for (int q = tri_off[i]; q < tri_off[i + 1]; ++q) {
           const int t = corners[q] / 3, ci = corners[q] % 3;
           for (int cj = 0; cj < 3; ++cj)
-            if (tri[3 * t + cj] == cols[sl]) entries.push_back(9 * t + 3 * ci + cj);
+            if (tri[3 * t + cj] == cols[sl]) entries.push_back(16 * t + 4 * ci + cj);  // split by shifts
         }
         offsets.push_back(static_cast<int>(entries.size()));
       }
@@ -390,7 +390,8 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
             substrate.add_block(i, cols(s), blk);
             if (with_tension)
               for (int q = slot_t_off(s); q < slot_t_off(s + 1); ++q) {
-                const int t = slot_t(q) / 9, ci = slot_t(q) / 3 % 3, cj = slot_t(q) % 3;
+                const int t = slot_t(q) >> 4, ci = (slot_t(q) >> 2) & 3,
+                          cj = slot_t(q) & 3;  // 16 t + 4 ci + cj
                 const double w = t_edge(t, ci, 0) * t_edge(t, cj, 0) + t_edge(t, ci, 1) * t_edge(t, cj, 1) +
                                  t_edge(t, ci, 2) * t_edge(t, cj, 2);
                 add_dashpot_block(load3(t_normal, t), w, 0.0, 1.0, blk);  // w n_t n_tᵀ
