@@ -184,6 +184,10 @@ std::vector<ParamSpec> make_schema() {
       real_key("solver.mg_damping", "0.6", 0, 0.66, kExcl, "",
                "multigrid: the smoother's damping ω (ω λ_max(D⁻¹A) < 2 keeps the V-cycle positive definite, "
                "and λ_max ≤ 3 on the finest level)"),
+      int_key("solver.mg_serial_rows", "1024", 0, 1e9,
+              "multigrid: coarse levels with at most this many rows (all cells) run on one thread in OpenMP "
+              "builds, where a parallel launch costs more than the work it shares; 0 = never (the results "
+              "are the same to the bit either way)"),
       string_key(
           "solver.mg_bending", "auto", {"auto", "on", "off"},
           "multigrid: the implicit bending stiffness in the preconditioner (a positive semi-definite "

@@ -45,6 +45,7 @@ using Clock = std::chrono::steady_clock;
 // Kokkos Tools: accumulated seconds per kernel label.
 struct KernelTimes {
   std::map<std::string, double> seconds;
+  std::map<std::string, long> launches;
   std::vector<std::pair<std::string, Clock::time_point>> open;  // indexed by the kernel id handed out
   bool on = false;
 };
@@ -56,7 +57,10 @@ void begin_kernel(const char* name, std::uint32_t, std::uint64_t* id) {
 }
 void end_kernel(std::uint64_t id) {
   const auto& [name, t0] = g_times.open[id];
-  if (g_times.on) g_times.seconds[name] += std::chrono::duration<double>(Clock::now() - t0).count();
+  if (g_times.on) {
+    g_times.seconds[name] += std::chrono::duration<double>(Clock::now() - t0).count();
+    ++g_times.launches[name];
+  }
   if (id + 1 == g_times.open.size()) g_times.open.pop_back();
 }
 void install_kernel_timer() {
@@ -111,6 +115,7 @@ void run_case(const std::string& space_name, int threads, const std::string& kin
   const dcm::CgSettings cg = dcm::cg_settings_from_scene(scene);
   int n = 0;
   std::map<std::string, double> best_kernels;
+  std::map<std::string, long> best_launches;
   double step_s = INFINITY;
   long iterations = 0;
   // Each repetition starts again from the same state (a new model: the steps of every block are the same
@@ -129,6 +134,7 @@ void run_case(const std::string& space_name, int threads, const std::string& kin
     dcm::TimeStepper<Exec> stepper(model, dcm::steps_from_scene(scene));
     for (int s = 0; s < o.warmup; ++s) stepper.step(model, cg, 1.0, [](double) {});
     g_times.seconds.clear();
+    g_times.launches.clear();
     g_times.on = true;
     long its = 0;
     const auto t0 = Clock::now();
@@ -138,21 +144,25 @@ void run_case(const std::string& space_name, int threads, const std::string& kin
     if (block_s < step_s) {
       step_s = block_s;
       best_kernels = g_times.seconds;
+      best_launches = g_times.launches;
       iterations = its;
     }
   }
-  const auto row = [&](const std::string& kernel, double seconds_per_step) {
-    std::printf("%s,%d,%s,%d,%s,%.3f,%.2f,%.2f\n", space_name.c_str(), threads, kind.c_str(), n,
+  const auto row = [&](const std::string& kernel, double seconds_per_step, double launches_per_step) {
+    std::printf("%s,%d,%s,%d,%s,%.3f,%.2f,%.2f,%.2f\n", space_name.c_str(), threads, kind.c_str(), n,
                 kernel.c_str(), seconds_per_step * 1e6, seconds_per_step * 1e9 / n,
-                static_cast<double>(iterations) / o.steps);
+                static_cast<double>(iterations) / o.steps, launches_per_step);
   };
   double covered = 0;
+  long launches = 0;
   for (const auto& [name, sec] : best_kernels) {
-    row(name, sec / o.steps);
+    const long count = best_launches[name];
+    row(name, sec / o.steps, static_cast<double>(count) / o.steps);
     covered += sec / o.steps;
+    launches += count;
   }
-  row("other", step_s - covered);
-  row("step", step_s);
+  row("other", step_s - covered, 0);
+  row("step", step_s, static_cast<double>(launches) / o.steps);
   std::fflush(stdout);
 }
 
@@ -229,7 +239,8 @@ int main(int argc, char** argv) {
     }
     return 0;
   }
-  std::printf("space,threads,scene,nodes,kernel,us_per_step,ns_per_node,cg_iterations_per_step\n");
+  std::printf(
+      "space,threads,scene,nodes,kernel,us_per_step,ns_per_node,cg_iterations_per_step,launches_per_step\n");
   std::fflush(stdout);
   char self[4096];
   const ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);

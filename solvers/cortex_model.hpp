@@ -94,7 +94,8 @@ inline std::string batch_mismatch(const MechanicsParams& a, const MechanicsParam
       {"the curvature clamp h_min", a.h_min != b.h_min},
       {"the preconditioner (multigrid, its sweeps and damping)",
        a.multigrid != b.multigrid || a.mg.sweeps != b.mg.sweeps || a.mg.damping != b.mg.damping ||
-           a.mg.bending != b.mg.bending || a.precondition_volume != b.precondition_volume},
+           a.mg.serial_rows != b.mg.serial_rows || a.mg.bending != b.mg.bending ||
+           a.precondition_volume != b.precondition_volume},
       {"the implicit terms", a.implicit_bonds != b.implicit_bonds ||
                                  a.implicit_bending != b.implicit_bending ||
                                  a.implicit_tension != b.implicit_tension},

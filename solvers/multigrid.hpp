@@ -47,7 +47,27 @@ struct MultigridSettings {
   enum class Bending { automatic, on, off };
   Bending bending = Bending::automatic;
   static constexpr double kAutoRatio = 0.15;
+  // Levels 1.. with at most this many rows (all cells together) run on one host thread (Kokkos::Serial)
+  // when the solve runs on OpenMP: on the small levels a parallel launch costs more than the work it shares
+  // (docs/model/solver.md, "Small levels on one thread"). 0: every level on the solve's space. Other
+  // backends (CUDA) always keep every level on their space. The results are the same to the bit.
+  int serial_rows = 1024;
 };
+
+// The execution space a small multigrid level runs on (MultigridSettings::serial_rows): Kokkos::Serial for
+// an OpenMP solve when the build has Serial; otherwise the solve's own space (kAvailable false).
+template <class ExecutionSpace>
+struct SmallLevelSpace {
+  static constexpr bool kAvailable = false;
+  using type = ExecutionSpace;
+};
+#if defined(KOKKOS_ENABLE_OPENMP) && defined(KOKKOS_ENABLE_SERIAL)
+template <>
+struct SmallLevelSpace<Kokkos::OpenMP> {
+  static constexpr bool kAvailable = true;
+  using type = Kokkos::Serial;
+};
+#endif
 
 // How strongly the implicit bending stiffens the soft (normal) modes of a cell against its dashpots, the
 // measure MultigridSettings::Bending::automatic decides by (docs/model/solver.md): a normal displacement at
@@ -285,6 +305,26 @@ Multigrid<MemorySpace> make_multigrid(const std::vector<HostCell>& cells,
 
 namespace mg_detail {
 
+// Level l's blocks A_l = Pᵀ A_{l−1} P from level l − 1's, and their inverted diagonal.
+template <class ExecutionSpace, class MemorySpace>
+void galerkin_level(const ExecutionSpace& space, const Multigrid<MemorySpace>& mg, std::size_t l) {
+  const auto fine = mg.levels[l - 1].a.values;
+  const MultigridLevel<MemorySpace>& lv = mg.levels[l];
+  const auto val = lv.a.values;
+  const auto goff = lv.galerkin_offsets;
+  const auto src = lv.galerkin_source;
+  const auto w = lv.galerkin_weight;
+  Kokkos::parallel_for(
+      "dcm::mg::galerkin", Kokkos::RangePolicy<ExecutionSpace>(space, 0, lv.a.nnz),
+      KOKKOS_LAMBDA(const int s) {
+        double blk[6] = {0, 0, 0, 0, 0, 0};
+        for (int q = goff(s); q < goff(s + 1); ++q)
+          for (int k = 0; k < 6; ++k) blk[k] += w(q) * fine(src(q), k);
+        for (int k = 0; k < 6; ++k) val(s, k) = blk[k];
+      });
+  block_csr_invert_diagonal(space, lv.a);
+}
+
 // The per-hinge factors of level 0's bending blocks (update_multigrid adds them). Level 0 = the operator's
 // blocks + a positive semi-definite approximation of the implicit bending
 // Δt k_b max(cos(θ − θ*), 0) ∇θ ∇θᵀ per hinge (solvers/bending_stiffness.hpp) on the bond pattern: each
@@ -415,21 +455,14 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
     block_csr_invert_diagonal(space, a);
   }
   for (std::size_t l = 1; l < mg.levels.size(); ++l) {  // A_l = Pᵀ A_{l−1} P
-    const auto fine = mg.levels[l - 1].a.values;
-    const MultigridLevel<MemorySpace>& lv = mg.levels[l];
-    const auto val = lv.a.values;
-    const auto goff = lv.galerkin_offsets;
-    const auto src = lv.galerkin_source;
-    const auto w = lv.galerkin_weight;
-    Kokkos::parallel_for(
-        "dcm::mg::galerkin", Kokkos::RangePolicy<ExecutionSpace>(space, 0, lv.a.nnz),
-        KOKKOS_LAMBDA(const int s) {
-          double blk[6] = {0, 0, 0, 0, 0, 0};
-          for (int q = goff(s); q < goff(s + 1); ++q)
-            for (int k = 0; k < 6; ++k) blk[k] += w(q) * fine(src(q), k);
-          for (int k = 0; k < 6; ++k) val(s, k) = blk[k];
-        });
-    block_csr_invert_diagonal(space, lv.a);
+    if constexpr (SmallLevelSpace<ExecutionSpace>::kAvailable) {
+      if (mg.levels[l].a.n_rows <= mg.settings.serial_rows) {
+        space.fence();
+        mg_detail::galerkin_level(typename SmallLevelSpace<ExecutionSpace>::type(), mg, l);
+        continue;
+      }
+    }
+    mg_detail::galerkin_level(space, mg, l);
   }
   if (!mg.available) return;
   // Coarsest level: 12 nodes per cell, uncoupled cells; dense Cholesky inverse on the host.
@@ -516,6 +549,15 @@ template <class ExecutionSpace, class MemorySpace, class Vector>
 void vcycle(const ExecutionSpace& space, const Multigrid<MemorySpace>& mg, std::size_t l, const Vector& b,
             const Vector& x, const CellFlags<MemorySpace>& active) {
   const MultigridLevel<MemorySpace>& lv = mg.levels[l];
+  if constexpr (SmallLevelSpace<ExecutionSpace>::kAvailable) {
+    if (l > 0 && lv.a.n_rows <= mg.settings.serial_rows) {  // this level and the coarser ones on one thread
+      space.fence();
+      const typename SmallLevelSpace<ExecutionSpace>::type serial;
+      vcycle(serial, mg, l, b, x, active);
+      serial.fence();
+      return;
+    }
+  }
   if (l + 1 == mg.levels.size()) {
     coarse_solve(space, mg, b, x, active);
     return;

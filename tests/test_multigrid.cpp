@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <cstdio>
+#include <type_traits>
 
 #include "core/host_copy.hpp"
 #include "core/update_geometry.hpp"
@@ -425,6 +426,36 @@ TEST(Multigrid, SeveralCellsOfDifferentDepth) {
   double res = 0;
   for (std::size_t i = 0; i < fh.size(); ++i) res += (gv[i] - fh[i]) * (gv[i] - fh[i]);
   EXPECT_LT(std::sqrt(res), 1e-9 * std::sqrt(dot_host(fh, fh)));
+}
+
+// MultigridSettings::serial_rows: the small levels on one host thread give the same Galerkin blocks and the
+// same V-cycle to the bit as every level on the solve's space (each row's arithmetic is the same).
+TEST(Multigrid, SmallLevelsOnOneThreadGiveTheSameBits) {
+#if defined(KOKKOS_ENABLE_OPENMP) && defined(KOKKOS_ENABLE_SERIAL)
+  if (std::is_same_v<Exec, Kokkos::OpenMP>) {
+    EXPECT_TRUE(SmallLevelSpace<Exec>::kAvailable);
+  }
+#endif
+  Preconditioned s({3, 2, 3});
+  const Vector r = s.random_vector(11);
+  std::vector<std::vector<double>> blocks_ref;
+  std::vector<double> z_ref;
+  for (const int rows : {0, 200, 1 << 30}) {  // none, the levels of ≤ 200 rows, every level ≥ 1
+    MultigridSettings ms;
+    ms.serial_rows = rows;
+    s.mg = make_multigrid(s.cells, s.mesh, ms);
+    update_multigrid(Exec(), s.mesh, s.op, s.mg);
+    const auto z = to_host_vector(s.vcycle(r));
+    if (rows == 0) {
+      for (const auto& lv : s.mg.levels) blocks_ref.push_back(to_host_vector(lv.a.values));
+      z_ref = z;
+      continue;
+    }
+    for (std::size_t l = 0; l < s.mg.levels.size(); ++l) {
+      EXPECT_EQ(to_host_vector(s.mg.levels[l].a.values), blocks_ref[l]) << "level " << l << ", rows " << rows;
+    }
+    EXPECT_EQ(z, z_ref) << "serial_rows " << rows;
+  }
 }
 
 TEST(Multigrid, MeshWithoutHierarchyFallsBackToBlockJacobi) {

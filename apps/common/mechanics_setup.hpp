@@ -29,6 +29,7 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
   p.multigrid = scene.get_string("solver.preconditioner") == "multigrid";
   p.mg.sweeps = static_cast<int>(scene.get_int("solver.mg_sweeps"));
   p.mg.damping = scene.get_real("solver.mg_damping");
+  p.mg.serial_rows = static_cast<int>(scene.get_int("solver.mg_serial_rows"));
   const std::string mg_bending = scene.get_string("solver.mg_bending");
   using Bending = MultigridSettings::Bending;
   p.mg.bending = mg_bending == "on" ? Bending::on : mg_bending == "off" ? Bending::off : Bending::automatic;
