@@ -104,4 +104,26 @@ void block_jacobi_step(const ExecutionSpace& space, const BlockCsr<MemorySpace>&
       });
 }
 
+// out = in + ω D⁻¹ (b − A in): one damped block-Jacobi sweep in one pass over the rows (the residual is not
+// stored). in and out must be different vectors. Rows of skipped cells keep out's values.
+template <class ExecutionSpace, class MemorySpace, class Vector>
+void block_jacobi_sweep(const ExecutionSpace& space, const BlockCsr<MemorySpace>& a, double omega,
+                        const Vector& b, const Vector& in, const Vector& out,
+                        const CellFlags<MemorySpace>& active = {}) {
+  const auto inv = a.diag_inverse;
+  const auto row_cell = a.row_cell;
+  const auto off = a.row_offsets;
+  const auto cols = a.cols;
+  const auto val = a.values;
+  Kokkos::parallel_for(
+      "dcm::bsr::jacobi_sweep", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows),
+      KOKKOS_LAMBDA(const int i) {
+        if (skipped(active, row_cell(i))) return;
+        const Real3 r = load3(b, i) - block_row_times(off, cols, val, in, i);
+        const Real3 dz =
+            omega * sym3_times(inv(i, 0), inv(i, 1), inv(i, 2), inv(i, 3), inv(i, 4), inv(i, 5), r);
+        store3(out, i, load3(in, i) + dz);
+      });
+}
+
 }  // namespace dcm

@@ -94,6 +94,7 @@ struct MultigridLevel {
   View<int*> galerkin_offsets, galerkin_source;
   View<double*> galerkin_weight;
   View<double*[3]> b, x, r;  // right-hand side and iterate (levels ≥ 1), residual
+  View<double* [3]> t;       // the smoother's second iterate
 };
 
 template <class MemorySpace>
@@ -222,6 +223,7 @@ Multigrid<MemorySpace> make_multigrid(const std::vector<HostCell>& cells,
     const int n = lv.a.n_rows;
     lv.a.row_cell = mg_detail::upload_vector<IV>("row_cell", row_cell);
     lv.r = typename MultigridLevel<MemorySpace>::template View<double* [3]>("dcm::mg::r", n);
+    lv.t = typename MultigridLevel<MemorySpace>::template View<double* [3]>("dcm::mg::t", n);
     if (l > 0) {
       lv.b = typename MultigridLevel<MemorySpace>::template View<double* [3]>("dcm::mg::b", n);
       lv.x = typename MultigridLevel<MemorySpace>::template View<double* [3]>("dcm::mg::x", n);
@@ -562,21 +564,23 @@ void vcycle(const ExecutionSpace& space, const Multigrid<MemorySpace>& mg, std::
     coarse_solve(space, mg, b, x, active);
     return;
   }
+  // Damped block-Jacobi sweeps, each one pass (block_jacobi_sweep) between x and the level's second iterate
+  // t; the first sweep (from 0) writes t, so that after ν pre- and ν post-sweeps the result is in x.
   const double omega = mg.settings.damping;
-  block_jacobi_step(space, lv.a, omega, false, b, x, active);  // first sweep from x = 0
-  for (int s = 1; s < mg.settings.sweeps; ++s) {
-    block_csr_residual(space, lv.a, b, x, lv.r, active);
-    block_jacobi_step(space, lv.a, omega, true, lv.r, x, active);
-  }
-  block_csr_residual(space, lv.a, b, x, lv.r, active);
+  const int nu = mg.settings.sweeps;
+  const Vector& t = lv.t;
+  const Vector& pre = nu % 2 == 0 ? x : t;                     // where the pre-smoothed iterate ends
+  const Vector& other = nu % 2 == 0 ? t : x;                   // the other buffer
+  block_jacobi_step(space, lv.a, omega, false, b, t, active);  // t = ω D⁻¹ b, the first sweep from 0
+  for (int s = 1; s < nu; ++s)
+    block_jacobi_sweep(space, lv.a, omega, b, s % 2 ? t : x, s % 2 ? x : t, active);
+  block_csr_residual(space, lv.a, b, pre, lv.r, active);
   const MultigridLevel<MemorySpace>& next = mg.levels[l + 1];
   restrict_residual(space, lv, next, lv.r, next.b, active);
   vcycle(space, mg, l + 1, next.b, next.x, active);
-  prolong_add(space, lv, next.x, x, active);
-  for (int s = 0; s < mg.settings.sweeps; ++s) {
-    block_csr_residual(space, lv.a, b, x, lv.r, active);
-    block_jacobi_step(space, lv.a, omega, true, lv.r, x, active);
-  }
+  prolong_add(space, lv, next.x, pre, active);
+  for (int s = 0; s < nu; ++s)  // ends in x: ν sweeps from pre
+    block_jacobi_sweep(space, lv.a, omega, b, s % 2 == 0 ? pre : other, s % 2 == 0 ? other : pre, active);
 }
 
 }  // namespace mg_detail
