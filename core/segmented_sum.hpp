@@ -6,7 +6,8 @@
 // sums in order. A Kokkos::parallel_reduce instead combines per-thread partial sums, so its last bits change
 // with OMP_NUM_THREADS; with these sums a run is bitwise the same on 1 and 2 threads (ctest
 // app.spread_thread_independent), and a cell's sums do not depend on the other cells of a batch.
-// Cost: two launches and a host copy per sum instead of one reduction; on the CPU the same time (bench_step).
+// Cost: two launches and a host copy per sum instead of one reduction; on the CPU the same time (bench_step);
+// with OpenMP the second launch runs on one thread (core/small_launch.hpp).
 // On a GPU a work item per 64 consecutive elements reads uncoalesced; a fixed warp-level tree per chunk would
 // keep the order and read coalesced (not done: no GPU to measure it on).
 //
@@ -21,10 +22,14 @@
 #include <vector>
 
 #include "core/kokkos_compat.hpp"
+#include "core/small_launch.hpp"
 
 namespace dcm {
 
 constexpr int kSumChunk = 64;
+// The per-segment pass (adding each segment's chunk sums) runs on one host thread (core/small_launch.hpp)
+// up to this many chunks: it is a few hundred additions per cell.
+constexpr int kSumSerialChunks = 1 << 16;
 constexpr int kSumMaxComponents = 4;
 
 template <class MemorySpace>
@@ -69,23 +74,14 @@ struct SumPlan {
   }
 };
 
-// out(s, c) = Σ over the elements k of segment s of the c-th component term(k, acc) adds, for c < N.
-// term may also write per-element results (each element is visited exactly once).
-// The kernels are labelled `label` (chunks) and `label`::segments, so profiles keep the caller's name.
-template <int N, class ExecutionSpace, class MemorySpace, class Term, class Out>
-void segmented_sum(const std::string& label, const ExecutionSpace& space, const SumPlan<MemorySpace>& plan,
-                   const Term& term, const Out& out) {
-  static_assert(N >= 1 && N <= kSumMaxComponents, "segmented_sum: 1 to 4 components");
-  const auto range = plan.chunk_range;
+namespace sum_detail {
+
+// out(s, c) = the sum of segment s's chunk sums, in order (segmented_sum's second launch).
+template <int N, class ExecutionSpace, class MemorySpace, class Out>
+void segment_pass(const std::string& label, const ExecutionSpace& space, const SumPlan<MemorySpace>& plan,
+                  const Out& out) {
   const auto partial = plan.partial;
   const auto chunks = plan.segment_chunks;
-  Kokkos::parallel_for(
-      label, Kokkos::RangePolicy<ExecutionSpace>(space, 0, plan.n_chunks), KOKKOS_LAMBDA(const int q) {
-        double acc[N];
-        for (int c = 0; c < N; ++c) acc[c] = 0;
-        for (int k = range(q, 0); k < range(q, 1); ++k) term(k, acc);
-        for (int c = 0; c < N; ++c) partial(q, c) = acc[c];
-      });
   Kokkos::parallel_for(
       label + "::segments", Kokkos::RangePolicy<ExecutionSpace>(space, 0, plan.n_segments),
       KOKKOS_LAMBDA(const int s) {
@@ -95,6 +91,51 @@ void segmented_sum(const std::string& label, const ExecutionSpace& space, const 
           for (int c = 0; c < N; ++c) acc[c] += partial(q, c);
         for (int c = 0; c < N; ++c) out(s, c) = acc[c];
       });
+}
+
+// result(s, 0) = the largest of segment s's chunk maxima (segmented_max's second launch).
+template <class ExecutionSpace, class MemorySpace>
+void segment_max_pass(const std::string& label, const ExecutionSpace& space,
+                      const SumPlan<MemorySpace>& plan) {
+  const auto partial = plan.partial;
+  const auto chunks = plan.segment_chunks;
+  const auto result = plan.result;
+  Kokkos::parallel_for(
+      label + "::segments", Kokkos::RangePolicy<ExecutionSpace>(space, 0, plan.n_segments),
+      KOKKOS_LAMBDA(const int s) {
+        double m = 0;
+        for (int q = chunks(s); q < chunks(s + 1); ++q)
+          if (partial(q, 0) > m) m = partial(q, 0);
+        result(s, 0) = m;
+      });
+}
+
+}  // namespace sum_detail
+
+// out(s, c) = Σ over the elements k of segment s of the c-th component term(k, acc) adds, for c < N.
+// term may also write per-element results (each element is visited exactly once).
+// The kernels are labelled `label` (chunks) and `label`::segments, so profiles keep the caller's name.
+template <int N, class ExecutionSpace, class MemorySpace, class Term, class Out>
+void segmented_sum(const std::string& label, const ExecutionSpace& space, const SumPlan<MemorySpace>& plan,
+                   const Term& term, const Out& out) {
+  static_assert(N >= 1 && N <= kSumMaxComponents, "segmented_sum: 1 to 4 components");
+  const auto range = plan.chunk_range;
+  const auto partial = plan.partial;
+  Kokkos::parallel_for(
+      label, Kokkos::RangePolicy<ExecutionSpace>(space, 0, plan.n_chunks), KOKKOS_LAMBDA(const int q) {
+        double acc[N];
+        for (int c = 0; c < N; ++c) acc[c] = 0;
+        for (int k = range(q, 0); k < range(q, 1); ++k) term(k, acc);
+        for (int c = 0; c < N; ++c) partial(q, c) = acc[c];
+      });
+  if constexpr (SmallLaunchSpace<ExecutionSpace>::kAvailable) {
+    if (plan.n_chunks <= kSumSerialChunks) {
+      space.fence();
+      sum_detail::segment_pass<N>(label, typename SmallLaunchSpace<ExecutionSpace>::type(), plan, out);
+      return;
+    }
+  }
+  sum_detail::segment_pass<N>(label, space, plan, out);
 }
 
 // Two per-segment Views as the `out` of a two-component segmented_sum: out(s, 0) = first(s), out(s, 1) =
@@ -129,8 +170,6 @@ void segmented_max(const std::string& label, const ExecutionSpace& space, const 
                    const Term& term, std::vector<double>& out) {
   const auto range = plan.chunk_range;
   const auto partial = plan.partial;
-  const auto chunks = plan.segment_chunks;
-  const auto result = plan.result;
   Kokkos::parallel_for(
       label, Kokkos::RangePolicy<ExecutionSpace>(space, 0, plan.n_chunks), KOKKOS_LAMBDA(const int q) {
         double m = 0;
@@ -140,14 +179,15 @@ void segmented_max(const std::string& label, const ExecutionSpace& space, const 
         }
         partial(q, 0) = m;
       });
-  Kokkos::parallel_for(
-      label + "::segments", Kokkos::RangePolicy<ExecutionSpace>(space, 0, plan.n_segments),
-      KOKKOS_LAMBDA(const int s) {
-        double m = 0;
-        for (int q = chunks(s); q < chunks(s + 1); ++q)
-          if (partial(q, 0) > m) m = partial(q, 0);
-        result(s, 0) = m;
-      });
+  bool serial = false;
+  if constexpr (SmallLaunchSpace<ExecutionSpace>::kAvailable) {
+    serial = plan.n_chunks <= kSumSerialChunks;
+    if (serial) {
+      space.fence();
+      sum_detail::segment_max_pass(label, typename SmallLaunchSpace<ExecutionSpace>::type(), plan);
+    }
+  }
+  if (!serial) sum_detail::segment_max_pass(label, space, plan);
   Kokkos::deep_copy(space, plan.result_host, plan.result);
   space.fence();
   out.resize(plan.n_segments);

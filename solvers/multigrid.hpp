@@ -26,6 +26,7 @@
 #include "core/buffers.hpp"
 #include "core/errors.hpp"
 #include "core/host_copy.hpp"
+#include "core/small_launch.hpp"
 #include "kernels/bending.hpp"
 #include "solvers/bending_stiffness.hpp"
 #include "solvers/block_sparse.hpp"
@@ -53,21 +54,6 @@ struct MultigridSettings {
   // backends (CUDA) always keep every level on their space. The results are the same to the bit.
   int serial_rows = 1024;
 };
-
-// The execution space a small multigrid level runs on (MultigridSettings::serial_rows): Kokkos::Serial for
-// an OpenMP solve when the build has Serial; otherwise the solve's own space (kAvailable false).
-template <class ExecutionSpace>
-struct SmallLevelSpace {
-  static constexpr bool kAvailable = false;
-  using type = ExecutionSpace;
-};
-#if defined(KOKKOS_ENABLE_OPENMP) && defined(KOKKOS_ENABLE_SERIAL)
-template <>
-struct SmallLevelSpace<Kokkos::OpenMP> {
-  static constexpr bool kAvailable = true;
-  using type = Kokkos::Serial;
-};
-#endif
 
 // How strongly the implicit bending stiffens the soft (normal) modes of a cell against its dashpots, the
 // measure MultigridSettings::Bending::automatic decides by (docs/model/solver.md): a normal displacement at
@@ -457,10 +443,10 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
     block_csr_invert_diagonal(space, a);
   }
   for (std::size_t l = 1; l < mg.levels.size(); ++l) {  // A_l = Pᵀ A_{l−1} P
-    if constexpr (SmallLevelSpace<ExecutionSpace>::kAvailable) {
+    if constexpr (SmallLaunchSpace<ExecutionSpace>::kAvailable) {
       if (mg.levels[l].a.n_rows <= mg.settings.serial_rows) {
         space.fence();
-        mg_detail::galerkin_level(typename SmallLevelSpace<ExecutionSpace>::type(), mg, l);
+        mg_detail::galerkin_level(typename SmallLaunchSpace<ExecutionSpace>::type(), mg, l);
         continue;
       }
     }
@@ -551,10 +537,10 @@ template <class ExecutionSpace, class MemorySpace, class Vector>
 void vcycle(const ExecutionSpace& space, const Multigrid<MemorySpace>& mg, std::size_t l, const Vector& b,
             const Vector& x, const CellFlags<MemorySpace>& active) {
   const MultigridLevel<MemorySpace>& lv = mg.levels[l];
-  if constexpr (SmallLevelSpace<ExecutionSpace>::kAvailable) {
+  if constexpr (SmallLaunchSpace<ExecutionSpace>::kAvailable) {
     if (l > 0 && lv.a.n_rows <= mg.settings.serial_rows) {  // this level and the coarser ones on one thread
       space.fence();
-      const typename SmallLevelSpace<ExecutionSpace>::type serial;
+      const typename SmallLaunchSpace<ExecutionSpace>::type serial;
       vcycle(serial, mg, l, b, x, active);
       serial.fence();
       return;

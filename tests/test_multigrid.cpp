@@ -433,7 +433,7 @@ TEST(Multigrid, SeveralCellsOfDifferentDepth) {
 TEST(Multigrid, SmallLevelsOnOneThreadGiveTheSameBits) {
 #if defined(KOKKOS_ENABLE_OPENMP) && defined(KOKKOS_ENABLE_SERIAL)
   if (std::is_same_v<Exec, Kokkos::OpenMP>) {
-    EXPECT_TRUE(SmallLevelSpace<Exec>::kAvailable);
+    EXPECT_TRUE(SmallLaunchSpace<Exec>::kAvailable);
   }
 #endif
   Preconditioned s({3, 2, 3});
