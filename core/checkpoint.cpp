@@ -11,7 +11,7 @@
 namespace dcm {
 namespace {
 
-const char* const kFormat = "dcm-checkpoint-1";
+const char* const kFormat = "dcm-checkpoint-2";  // 2: icosphere nodes numbered for locality (session 22)
 
 // Closes an HDF5 identifier on scope exit.
 struct Handle {

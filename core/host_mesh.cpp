@@ -58,12 +58,36 @@ void subdivide(HostMesh& m) {
   m.triangles = std::move(next);
 }
 
+// Renumbers the nodes in the order they first appear in the triangle list. Subdivision lists the four
+// children of a triangle together, so the triangles follow a quadtree over the 20 faces and this order keeps
+// a node's neighbours close in memory, and a contiguous range of nodes (one thread's share of a kernel) a
+// compact patch: on two threads whose cores share no cache the kernels that read neighbours written by the
+// other thread lose most of their speed-up in subdivision order (docs/PERFORMANCE.md, "Session 22").
+void renumber_by_first_use(HostMesh& m) {
+  std::vector<int> id(m.nodes.size(), -1);
+  int next = 0;
+  for (const Tri& t : m.triangles)
+    for (int v : t)
+      if (id[v] < 0) id[v] = next++;
+  std::vector<Vec3> nodes(m.nodes.size());
+  std::vector<std::array<int, 2>> parents(m.nodes.size(), {-1, -1});
+  for (std::size_t i = 0; i < id.size(); ++i) {
+    nodes[id[i]] = m.nodes[i];
+    if (m.parents[i][0] >= 0) parents[id[i]] = {id[m.parents[i][0]], id[m.parents[i][1]]};
+  }
+  for (Tri& t : m.triangles)
+    for (int& v : t) v = id[v];
+  m.nodes = std::move(nodes);
+  m.parents = std::move(parents);
+}
+
 HostMesh unit_icosphere(int subdivisions) {
   if (subdivisions < 0 || subdivisions > 8)
     throw std::invalid_argument("icosphere subdivisions = " + std::to_string(subdivisions) +
                                 " is out of range: allowed 0 .. 8");
   HostMesh m = icosahedron();
   for (int k = 0; k < subdivisions; ++k) subdivide(m);
+  renumber_by_first_use(m);
   return m;
 }
 

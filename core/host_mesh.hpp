@@ -14,9 +14,10 @@ struct HostMesh {
   std::vector<Vec3> nodes;     // m
   std::vector<Tri> triangles;  // counter-clockwise seen from outside: normals point outward
   // Subdivision hierarchy (icosphere and Evans-Fung meshes): the two parent nodes of every node created
-  // as an edge midpoint, {-1, -1} for the 12 icosahedron nodes. Subdivision keeps the old nodes' indices
-  // and appends the midpoints, so the first 10*4^(k-1)+2 nodes of level k are the nodes of level k-1.
-  // Empty for meshes without such a hierarchy (the multigrid preconditioner then falls back).
+  // as an edge midpoint, {-1, -1} for the 12 icosahedron nodes. A node's subdivision level follows from
+  // them (0 for the icosahedron, else 1 + the larger of its parents' levels); the nodes of level <= j are
+  // the mesh of subdivision j. The nodes are numbered for locality (in the order the triangles first use
+  // them), not by level. Empty for meshes without such a hierarchy (the multigrid then falls back).
   std::vector<std::array<int, 2>> parents;
 };
 

@@ -4,9 +4,10 @@
 // recipe of the Galerkin products A_{l+1} = Pᵀ A_l P (which fine slots, with which weights, sum into each
 // coarse slot). The numeric part, rebuilt every step, is in solvers/multigrid.hpp.
 //
-// Levels: 0 is the mesh; level l holds, for each cell of subdivision k_c, its first 10·4^max(k_c−l,0)+2
-// nodes (the nodes of subdivision max(k_c − l, 0): make_icosphere keeps old indices and appends the
-// midpoints, HostMesh::parents records them). Cells are concatenated in the order of the buffers. Every
+// Levels: 0 is the mesh; level l holds, for each cell of subdivision k_c, its 10·4^max(k_c−l,0)+2 nodes of
+// subdivision level ≤ max(k_c − l, 0) (HostMesh::parents records the hierarchy; subdivision_levels() derives
+// each node's level), in the order of their mesh indices, so a coarse level keeps the mesh's locality.
+// Cells are concatenated in the order of the buffers. Every
 // cell reaches the 12 icosahedron nodes on the coarsest level, where a cell already there is carried
 // down unchanged (P = I for it). P sets a midpoint node to the mean of its two parents, per component;
 // the fine node i takes ½(x_c[p(i,0)] + x_c[p(i,1)]), with p(i,0) = p(i,1) for a node that survives.
@@ -151,49 +152,91 @@ inline HostTransfer make_transfer(const HostSparsePattern& fine, std::vector<std
   return t;
 }
 
+// Each node's subdivision level (0: an icosahedron node, else 1 + the larger of its parents' levels) from
+// HostMesh::parents, or an empty vector when they do not describe the icosphere hierarchy of subdivision k
+// (the nodes of level <= j must number 10·4^j + 2 for every j <= k).
+inline std::vector<int> subdivision_levels(const HostMesh& m, int k) {
+  const int n = static_cast<int>(m.nodes.size());
+  if (k < 0 || static_cast<int>(m.parents.size()) != n) return {};
+  std::vector<int> level(n, -1);
+  for (bool changed = true; changed;) {  // parents may be numbered after their children
+    changed = false;
+    for (int i = 0; i < n; ++i) {
+      if (level[i] >= 0) continue;
+      const auto p = m.parents[i];
+      if (p[0] < 0 && p[1] < 0) {
+        level[i] = 0;
+      } else if (p[0] < 0 || p[1] < 0 || p[0] >= n || p[1] >= n) {
+        return {};
+      } else if (level[p[0]] >= 0 && level[p[1]] >= 0) {
+        level[i] = 1 + std::max(level[p[0]], level[p[1]]);
+      } else {
+        continue;
+      }
+      changed = true;
+    }
+  }
+  std::vector<long long> count(k + 1, 0);
+  for (const int l : level) {
+    if (l < 0 || l > k) return {};  // a cycle of parents, or deeper than the node count says
+    ++count[l];
+  }
+  long long total = 0;
+  for (int j = 0; j <= k; ++j)
+    if ((total += count[j]) != icosphere_node_count(j)) return {};
+  return level;
+}
+
 // The hierarchy of cells concatenated in this order; bond_pairs are MeshBuffers::bond on the host.
 inline HostHierarchy make_hierarchy(const std::vector<HostCell>& cells, int n_nodes,
                                     const std::vector<int>& bond_pairs) {
   HostHierarchy h;
   h.n_cells = static_cast<int>(cells.size());
   h.fine = bond_pattern(n_nodes, bond_pairs, h.fine_slot_bond);
-  std::vector<int> level(cells.size());
+  std::vector<int> depth_of(cells.size());
+  std::vector<std::vector<int>> node_level(cells.size());
   int depth = 0;
   for (std::size_t c = 0; c < cells.size(); ++c) {
     const HostMesh& m = cells[c].mesh;
     const int k = icosphere_level_of(m.nodes.size());
-    bool ok = k >= 0 && m.parents.size() == m.nodes.size();
-    for (int j = 1; ok && j <= k; ++j)
-      for (long long i = icosphere_node_count(j - 1); ok && i < icosphere_node_count(j); ++i)
-        ok = m.parents[i][0] >= 0 && m.parents[i][1] >= 0 && m.parents[i][0] < icosphere_node_count(j - 1) &&
-             m.parents[i][1] < icosphere_node_count(j - 1);
-    if (!ok) {
+    node_level[c] = subdivision_levels(m, k);
+    if (node_level[c].empty()) {
       h.note = "cell " + std::to_string(c) + " (" + std::to_string(m.nodes.size()) +
                " nodes) has no icosphere subdivision hierarchy (HostMesh::parents): multigrid falls back to "
                "block-Jacobi";
       return h;
     }
-    level[c] = k;
+    depth_of[c] = k;
     depth = std::max(depth, k);
   }
-  auto count = [&](std::size_t c, int l) {
-    return static_cast<int>(icosphere_node_count(std::max(level[c] - l, 0)));
-  };
+  // rank[c][i]: node i's index within cell c's part of the current level (−1: not on it).
+  std::vector<std::vector<int>> rank(cells.size());
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    rank[c].resize(node_level[c].size());
+    for (std::size_t i = 0; i < rank[c].size(); ++i) rank[c][i] = static_cast<int>(i);
+  }
   const HostSparsePattern* fine = &h.fine;
   h.transfers.reserve(depth);
   for (int l = 0; l < depth; ++l) {
     std::vector<std::array<int, 2>> prolong;
     int coarse_begin = 0;
     for (std::size_t c = 0; c < cells.size(); ++c) {
-      const int nf = count(c, l), nc = count(c, l + 1);
-      for (int i = 0; i < nf; ++i) {
-        if (i < nc) {
-          prolong.push_back({coarse_begin + i, coarse_begin + i});
+      const std::vector<int>& lev = node_level[c];
+      const int keep = std::max(depth_of[c] - l - 1, 0);  // the coarse level's subdivision
+      std::vector<int> coarse_rank(lev.size(), -1);
+      int nc = 0;
+      for (std::size_t i = 0; i < lev.size(); ++i)
+        if (rank[c][i] >= 0 && lev[i] <= keep) coarse_rank[i] = nc++;
+      for (std::size_t i = 0; i < lev.size(); ++i) {  // the fine level's nodes, in their order
+        if (rank[c][i] < 0) continue;
+        if (coarse_rank[i] >= 0) {
+          prolong.push_back({coarse_begin + coarse_rank[i], coarse_begin + coarse_rank[i]});
         } else {
           const auto p = cells[c].mesh.parents[i];
-          prolong.push_back({coarse_begin + p[0], coarse_begin + p[1]});
+          prolong.push_back({coarse_begin + coarse_rank[p[0]], coarse_begin + coarse_rank[p[1]]});
         }
       }
+      rank[c] = std::move(coarse_rank);
       coarse_begin += nc;
     }
     h.transfers.push_back(make_transfer(*fine, std::move(prolong), coarse_begin));

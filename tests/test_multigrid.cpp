@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <type_traits>
@@ -85,18 +86,46 @@ struct Preconditioned : FrictionSetup {
 TEST(Multigrid, IcosphereRecordsItsSubdivisionParents) {
   const HostMesh m = make_icosphere(3, 1.0);
   ASSERT_EQ(m.parents.size(), m.nodes.size());
-  for (int i = 0; i < 12; ++i) EXPECT_EQ(m.parents[i][0], -1);
-  for (int k = 1; k <= 3; ++k)
-    for (long long i = icosphere_node_count(k - 1); i < icosphere_node_count(k); ++i) {
-      const auto p = m.parents[i];
-      ASSERT_LT(p[0], icosphere_node_count(k - 1));
-      ASSERT_LT(p[1], icosphere_node_count(k - 1));
-      Vec3 mid{};
-      for (int d = 0; d < 3; ++d) mid[d] = m.nodes[p[0]][d] + m.nodes[p[1]][d];
-      const double n = std::sqrt(mid[0] * mid[0] + mid[1] * mid[1] + mid[2] * mid[2]);
-      for (int d = 0; d < 3; ++d) EXPECT_NEAR(m.nodes[i][d], mid[d] / n, 1e-14);  // the projected midpoint
+  const std::vector<int> level = subdivision_levels(m, 3);
+  ASSERT_EQ(level.size(), m.nodes.size());
+  std::vector<int> count(4, 0);
+  for (std::size_t i = 0; i < m.nodes.size(); ++i) {
+    ++count[level[i]];
+    const auto p = m.parents[i];
+    if (level[i] == 0) {
+      EXPECT_EQ(p[0], -1);
+      continue;
     }
+    ASSERT_LT(level[p[0]], level[i]);
+    ASSERT_LT(level[p[1]], level[i]);
+    EXPECT_EQ(std::max(level[p[0]], level[p[1]]), level[i] - 1);
+    Vec3 mid{};
+    for (int d = 0; d < 3; ++d) mid[d] = m.nodes[p[0]][d] + m.nodes[p[1]][d];
+    const double n = std::sqrt(mid[0] * mid[0] + mid[1] * mid[1] + mid[2] * mid[2]);
+    for (int d = 0; d < 3; ++d) EXPECT_NEAR(m.nodes[i][d], mid[d] / n, 1e-14);  // the projected midpoint
+  }
+  EXPECT_EQ(count, (std::vector<int>{12, 30, 120, 480}));  // 10·4^k + 2 nodes up to level k
   EXPECT_EQ(make_evans_fung(2).parents, make_icosphere(2, 1.0).parents);
+  // Parents that do not describe a hierarchy: no levels (the multigrid falls back).
+  HostMesh broken = m;
+  broken.parents[100] = {-1, -1};  // a 13th level-0 node
+  EXPECT_TRUE(subdivision_levels(broken, 3).empty());
+}
+
+// The nodes are numbered for locality (HostMesh::parents): the triangles use them in order, so a thread's
+// contiguous share of the nodes is a compact patch. Each triangle's nodes lie within a short index window.
+TEST(Multigrid, IcosphereNodesAreNumberedForLocality) {
+  const HostMesh m = make_icosphere(5, 1.0);
+  int next = 0;
+  for (const Tri& t : m.triangles)
+    for (int v : t) {
+      ASSERT_LE(v, next);  // first use in triangle order
+      if (v == next) ++next;
+    }
+  EXPECT_EQ(next, static_cast<int>(m.nodes.size()));
+  long long span = 0;  // mean index spread of a triangle's nodes
+  for (const Tri& t : m.triangles) span += std::max({t[0], t[1], t[2]}) - std::min({t[0], t[1], t[2]});
+  EXPECT_LT(static_cast<double>(span) / m.triangles.size(), 0.05 * m.nodes.size());  // 2.8% here
 }
 
 TEST(Multigrid, RestrictionIsTheTransposeOfProlongation) {

@@ -168,12 +168,13 @@ TEST(Pcg, AgreesWithEigenReferenceOn642Nodes) {
   const Eigen::VectorXd diff = Eigen::Map<const Eigen::VectorXd>(vh.data(), vh.size()) - reference;
   EXPECT_LT(diff.norm(), 1e-8 * reference.norm());
 
-  // Warm start from the solution: converged at once (round-off may ask for an iteration or two).
+  // Warm start from the solution: converged at once (round-off may ask for a few iterations: 2 with the
+  // nodes in subdivision order, 3 in the locality order of session 22).
   const CgResult again = pcg_solve(
       space, [&](const Vector& in, const Vector& out) { apply_friction(space, s.mesh, s.op, in, out); },
       [&](const Vector& in, const Vector& out) { apply_block_jacobi(space, s.op, in, out); }, f, v, w,
       settings);
-  EXPECT_LE(again.iterations, 2);
+  EXPECT_LE(again.iterations, 3);
 }
 
 TEST(Pcg, ReportsNonConvergence) {
