@@ -1,7 +1,7 @@
 #pragma once
 // Block-sparse symmetric matrices with symmetric 3×3 blocks (CSR over nodes), for the assembled coarse
 // levels of the multigrid preconditioner (solvers/multigrid.hpp): y = A x, r = b − A x, the inverted
-// diagonal blocks and a damped block-Jacobi update. Blocks are packed xx, yy, zz, xy, xz, yz like
+// diagonal blocks and damped block-Jacobi steps. Blocks are packed xx, yy, zz, xy, xz, yz like
 // FrictionOperator::block_inverse. Every block of Γ (ζ I and c n̂n̂ᵀ) is symmetric, and so is every
 // Galerkin product of them with the scalar prolongation P ⊗ I₃.
 #include "core/vec3.hpp"
@@ -87,20 +87,20 @@ void block_csr_invert_diagonal(const ExecutionSpace& space, const BlockCsr<Memor
       });
 }
 
-// x = (accumulate ? x : 0) + ω D⁻¹ r: one damped block-Jacobi step given the residual r.
+// x = ω D⁻¹ r: a damped block-Jacobi step from x = 0 (the smoother's first sweep; block-Jacobi itself with
+// ω = 1).
 template <class ExecutionSpace, class MemorySpace, class Vector>
 void block_jacobi_step(const ExecutionSpace& space, const BlockCsr<MemorySpace>& a, double omega,
-                       bool accumulate, const Vector& r, const Vector& x,
-                       const CellFlags<MemorySpace>& active = {}) {
+                       const Vector& r, const Vector& x, const CellFlags<MemorySpace>& active = {}) {
   const auto inv = a.diag_inverse;
   const auto row_cell = a.row_cell;
   Kokkos::parallel_for(
       "dcm::bsr::jacobi_step", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.n_rows),
       KOKKOS_LAMBDA(const int i) {
         if (skipped(active, row_cell(i))) return;
-        const Real3 dz =
-            omega * sym3_times(inv(i, 0), inv(i, 1), inv(i, 2), inv(i, 3), inv(i, 4), inv(i, 5), load3(r, i));
-        store3(x, i, accumulate ? load3(x, i) + dz : dz);
+        store3(x, i,
+               omega *
+                   sym3_times(inv(i, 0), inv(i, 1), inv(i, 2), inv(i, 3), inv(i, 4), inv(i, 5), load3(r, i)));
       });
 }
 

@@ -555,9 +555,9 @@ void vcycle(const ExecutionSpace& space, const Multigrid<MemorySpace>& mg, std::
   const double omega = mg.settings.damping;
   const int nu = mg.settings.sweeps;
   const Vector& t = lv.t;
-  const Vector& pre = nu % 2 == 0 ? x : t;                     // where the pre-smoothed iterate ends
-  const Vector& other = nu % 2 == 0 ? t : x;                   // the other buffer
-  block_jacobi_step(space, lv.a, omega, false, b, t, active);  // t = ω D⁻¹ b, the first sweep from 0
+  const Vector& pre = nu % 2 == 0 ? x : t;              // where the pre-smoothed iterate ends
+  const Vector& other = nu % 2 == 0 ? t : x;            // the other buffer
+  block_jacobi_step(space, lv.a, omega, b, t, active);  // t = ω D⁻¹ b, the first sweep from 0
   for (int s = 1; s < nu; ++s)
     block_jacobi_sweep(space, lv.a, omega, b, s % 2 ? t : x, s % 2 ? x : t, active);
   block_csr_residual(space, lv.a, b, pre, lv.r, active);
@@ -577,7 +577,7 @@ template <class ExecutionSpace, class MemorySpace, class Vector>
 void apply_multigrid(const ExecutionSpace& space, const Multigrid<MemorySpace>& mg, const Vector& r,
                      const Vector& z, const CellFlags<MemorySpace>& active = {}) {
   if (!mg.available) {
-    block_jacobi_step(space, mg.levels[0].a, 1.0, false, r, z, active);
+    block_jacobi_step(space, mg.levels[0].a, 1.0, r, z, active);
     return;
   }
   mg_detail::vcycle(space, mg, 0, r, z, active);
