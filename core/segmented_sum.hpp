@@ -128,14 +128,8 @@ void segmented_sum(const std::string& label, const ExecutionSpace& space, const 
         for (int k = range(q, 0); k < range(q, 1); ++k) term(k, acc);
         for (int c = 0; c < N; ++c) partial(q, c) = acc[c];
       });
-  if constexpr (SmallLaunchSpace<ExecutionSpace>::kAvailable) {
-    if (plan.n_chunks <= kSumSerialChunks) {
-      space.fence();
-      sum_detail::segment_pass<N>(label, typename SmallLaunchSpace<ExecutionSpace>::type(), plan, out);
-      return;
-    }
-  }
-  sum_detail::segment_pass<N>(label, space, plan, out);
+  on_small_space(space, plan.n_chunks <= kSumSerialChunks,
+                 [&](const auto& s) { sum_detail::segment_pass<N>(label, s, plan, out); });
 }
 
 // Two per-segment Views as the `out` of a two-component segmented_sum: out(s, 0) = first(s), out(s, 1) =
@@ -179,15 +173,8 @@ void segmented_max(const std::string& label, const ExecutionSpace& space, const 
         }
         partial(q, 0) = m;
       });
-  bool serial = false;
-  if constexpr (SmallLaunchSpace<ExecutionSpace>::kAvailable) {
-    serial = plan.n_chunks <= kSumSerialChunks;
-    if (serial) {
-      space.fence();
-      sum_detail::segment_max_pass(label, typename SmallLaunchSpace<ExecutionSpace>::type(), plan);
-    }
-  }
-  if (!serial) sum_detail::segment_max_pass(label, space, plan);
+  on_small_space(space, plan.n_chunks <= kSumSerialChunks,
+                 [&](const auto& s) { sum_detail::segment_max_pass(label, s, plan); });
   Kokkos::deep_copy(space, plan.result_host, plan.result);
   space.fence();
   out.resize(plan.n_segments);

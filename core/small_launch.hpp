@@ -6,8 +6,7 @@
 // the build has it: the same kernels, run on the calling thread, in the same memory (HostSpace). Every
 // other backend (CUDA, Serial itself) keeps its own space (kAvailable false).
 //
-//   if constexpr (SmallLaunchSpace<Exec>::kAvailable)
-//     if (n <= threshold) { space.fence(); run(typename SmallLaunchSpace<Exec>::type(), ...); return; }
+//   on_small_space(space, n <= threshold, [&](const auto& s) { launch(s, ...); });
 //
 // The kernels must compute each work item independently (no reductions across items), so that the results
 // are the same to the bit on either space.
@@ -27,5 +26,21 @@ struct SmallLaunchSpace<Kokkos::OpenMP> {
   using type = Kokkos::Serial;
 };
 #endif
+
+// launch(space), or, when small and the backend has a SmallLaunchSpace, launch(that space) after the
+// solve's space has finished its work (launch takes the space as a generic parameter).
+template <class ExecutionSpace, class Launch>
+void on_small_space(const ExecutionSpace& space, bool small, const Launch& launch) {
+  if constexpr (SmallLaunchSpace<ExecutionSpace>::kAvailable) {
+    if (small) {
+      space.fence();
+      const typename SmallLaunchSpace<ExecutionSpace>::type serial;
+      launch(serial);
+      serial.fence();
+      return;
+    }
+  }
+  launch(space);
+}
 
 }  // namespace dcm

@@ -443,14 +443,8 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
     block_csr_invert_diagonal(space, a);
   }
   for (std::size_t l = 1; l < mg.levels.size(); ++l) {  // A_l = Pᵀ A_{l−1} P
-    if constexpr (SmallLaunchSpace<ExecutionSpace>::kAvailable) {
-      if (mg.levels[l].a.n_rows <= mg.settings.serial_rows) {
-        space.fence();
-        mg_detail::galerkin_level(typename SmallLaunchSpace<ExecutionSpace>::type(), mg, l);
-        continue;
-      }
-    }
-    mg_detail::galerkin_level(space, mg, l);
+    on_small_space(space, mg.levels[l].a.n_rows <= mg.settings.serial_rows,
+                   [&](const auto& s) { mg_detail::galerkin_level(s, mg, l); });
   }
   if (!mg.available) return;
   // Coarsest level: 12 nodes per cell, uncoupled cells; dense Cholesky inverse on the host.
@@ -539,10 +533,7 @@ void vcycle(const ExecutionSpace& space, const Multigrid<MemorySpace>& mg, std::
   const MultigridLevel<MemorySpace>& lv = mg.levels[l];
   if constexpr (SmallLaunchSpace<ExecutionSpace>::kAvailable) {
     if (l > 0 && lv.a.n_rows <= mg.settings.serial_rows) {  // this level and the coarser ones on one thread
-      space.fence();
-      const typename SmallLaunchSpace<ExecutionSpace>::type serial;
-      vcycle(serial, mg, l, b, x, active);
-      serial.fence();
+      on_small_space(space, true, [&](const auto& s) { vcycle(s, mg, l, b, x, active); });
       return;
     }
   }
