@@ -9,6 +9,9 @@
 // Table 1 parameters and the solver defaults of the scenes (multigrid PCG to 1e-14 N, implicit bending and
 // tension). One row per (space, threads, scene, nodes, kernel): µs per step and ns per node per step; the
 // kernel "step" is the whole step (host work, copies and fences included), "other" what no kernel covers.
+// The last column, thread_round_trip_ns, is the OpenMP threads' cache-line round trip measured around the
+// reported block (0 for one thread): where a VM's two CPUs sit (one die or two) changes every two-thread time
+// (perf/speedup.py splits the runs by it).
 //   bench_step [--levels 3,4,5,6] [--scenes stretch,spread,diagonal] [--steps N] [--warmup N] [--threads 1,2]
 //              [--repeat N] [--rounds R] [--set KEY=VALUE]...
 // --repeat N runs each case N times from the same start (warm-up and timed steps) and reports the run with
@@ -23,6 +26,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -37,6 +41,10 @@
 #include "apps/common/stretch_setup.hpp"
 #include "core/kokkos_compat.hpp"
 #include "core/scene.hpp"
+
+#if defined(KOKKOS_ENABLE_OPENMP) && defined(_OPENMP)
+#include <omp.h>
+#endif
 
 namespace {
 
@@ -71,6 +79,44 @@ void install_kernel_timer() {
   KT::set_end_parallel_reduce_callback(end_kernel);
   KT::set_begin_parallel_scan_callback(begin_kernel);
   KT::set_end_parallel_scan_callback(end_kernel);
+}
+
+// The round trip of one cache line between OpenMP threads 0 and 1 (ns; 0 with fewer than two threads): on a
+// VM whose virtual CPUs the host moves between dies it changes from run to run (165 ns on one die, 440 ns
+// across dies in session 23), and with it every kernel's two-thread time, so each row carries it.
+double thread_round_trip_ns() {
+#if defined(KOKKOS_ENABLE_OPENMP) && defined(_OPENMP)
+  if (omp_get_max_threads() < 2) return 0;
+  // Up to 20000 round trips or 20 ms, whichever ends first: on a busy machine the two threads are not always
+  // running at once (then the number is large, and says so).
+  constexpr long kTrips = 20000, kStop = -1;
+  const auto budget = std::chrono::milliseconds(20);
+  alignas(64) std::atomic<long> flag{0};
+  double ns = 0;
+#pragma omp parallel num_threads(2)
+  {
+    const bool first = omp_get_thread_num() == 0;
+#pragma omp barrier
+    if (first) {
+      const auto t0 = Clock::now();
+      long trips = 0;
+      while (trips < kTrips && (trips % 256 != 0 || Clock::now() - t0 < budget)) {
+        flag.store(2 * trips + 1, std::memory_order_release);
+        while (flag.load(std::memory_order_acquire) != 2 * trips + 2) {
+        }
+        ++trips;
+      }
+      ns = std::chrono::duration<double>(Clock::now() - t0).count() * 1e9 / (trips > 0 ? trips : 1);
+      flag.store(kStop, std::memory_order_release);
+    } else {
+      for (long seen; (seen = flag.load(std::memory_order_acquire)) != kStop;)
+        if (seen % 2 == 1) flag.store(seen + 1, std::memory_order_release);
+    }
+  }
+  return ns;
+#else
+  return 0;
+#endif
 }
 
 struct Options {
@@ -116,7 +162,7 @@ void run_case(const std::string& space_name, int threads, const std::string& kin
   int n = 0;
   std::map<std::string, double> best_kernels;
   std::map<std::string, long> best_launches;
-  double step_s = INFINITY;
+  double step_s = INFINITY, round_trip_ns = 0;
   long iterations = 0;
   // Each repetition starts again from the same state (a new model: the steps of every block are the same
   // steps); the block with the shortest step time is reported.
@@ -135,23 +181,27 @@ void run_case(const std::string& space_name, int threads, const std::string& kin
     for (int s = 0; s < o.warmup; ++s) stepper.step(model, cg, 1.0, [](double) {});
     g_times.seconds.clear();
     g_times.launches.clear();
+    const bool threaded = threads > 1 && space_name == "OpenMP";
+    const double trip_before = threaded ? thread_round_trip_ns() : 0;
     g_times.on = true;
     long its = 0;
     const auto t0 = Clock::now();
     for (int s = 0; s < o.steps; ++s) its += stepper.step(model, cg, 1.0, [](double) {}).iterations;
     const double block_s = std::chrono::duration<double>(Clock::now() - t0).count() / o.steps;
     g_times.on = false;
+    const double trip_after = threaded ? thread_round_trip_ns() : 0;
     if (block_s < step_s) {
       step_s = block_s;
       best_kernels = g_times.seconds;
       best_launches = g_times.launches;
       iterations = its;
+      round_trip_ns = 0.5 * (trip_before + trip_after);
     }
   }
   const auto row = [&](const std::string& kernel, double seconds_per_step, double launches_per_step) {
-    std::printf("%s,%d,%s,%d,%s,%.3f,%.2f,%.2f,%.2f\n", space_name.c_str(), threads, kind.c_str(), n,
+    std::printf("%s,%d,%s,%d,%s,%.3f,%.2f,%.2f,%.2f,%.0f\n", space_name.c_str(), threads, kind.c_str(), n,
                 kernel.c_str(), seconds_per_step * 1e6, seconds_per_step * 1e9 / n,
-                static_cast<double>(iterations) / o.steps, launches_per_step);
+                static_cast<double>(iterations) / o.steps, launches_per_step, round_trip_ns);
   };
   double covered = 0;
   long launches = 0;
@@ -240,7 +290,8 @@ int main(int argc, char** argv) {
     return 0;
   }
   std::printf(
-      "space,threads,scene,nodes,kernel,us_per_step,ns_per_node,cg_iterations_per_step,launches_per_step\n");
+      "space,threads,scene,nodes,kernel,us_per_step,ns_per_node,cg_iterations_per_step,launches_per_step,"
+      "thread_round_trip_ns\n");
   std::fflush(stdout);
   char self[4096];
   const ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
