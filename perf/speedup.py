@@ -9,9 +9,13 @@ next: on session 23's 2-vCPU Zen 5 VM the round trip was 160-180 ns (same die) o
 a two-thread step at 10242 nodes took 10-25% longer on two dies. Mixing the two placements in one "fastest of
 N runs" hides which one a number belongs to, so this script keeps them apart: for each scene and node count,
 the fastest one-thread step over all runs, and the fastest two-thread step among the runs whose round trip was
-below --near-ns ("near") and among the others ("far"), each with its speed-up and the number of runs behind it.
+below --near-ns ("near") and among the others ("far"), each with its speed-up and the number of runs behind it;
+and, because the fastest of many one-thread runs against the fastest of few two-thread runs favours the one
+thread, the median of the speed-ups paired within each run (one bench_step run times both thread counts a few
+seconds apart).
 """
 import csv
+import statistics
 import sys
 from collections import defaultdict
 
@@ -28,7 +32,9 @@ def main():
         del args[i:i + 2]
     one = defaultdict(list)  # (scene, nodes) -> one-thread µs per step, one per run
     two = defaultdict(lambda: {"near": [], "far": []})  # (scene, nodes) -> placement -> [(µs, round trip ns)]
+    paired = defaultdict(lambda: {"near": [], "far": []})  # (scene, nodes) -> placement -> [1-thread / 2-thread]
     for path in args:
+        in_run = {}  # (scene, nodes, threads) -> (µs, round trip ns) of this run
         for r in csv.DictReader(open(path)):
             if r["kernel"] != "step" or r["space"] != "OpenMP":
                 continue
@@ -38,13 +44,20 @@ def main():
             us = float(r["us_per_step"])
             if int(r["threads"]) == 1:
                 one[key].append(us)
+                in_run[key + (1,)] = (us, 0.0)
             elif int(r["threads"]) == 2:
                 trip = float(r["thread_round_trip_ns"])
                 two[key]["near" if trip < near_ns else "far"].append((us, trip))
+                in_run[key + (2,)] = (us, trip)
+        for (scene, nodes, threads), (us, trip) in in_run.items():
+            if threads == 2 and (scene, nodes, 1) in in_run:
+                placement = "near" if trip < near_ns else "far"
+                paired[(scene, nodes)][placement].append(in_run[(scene, nodes, 1)][0] / us)
     print(f"{len(args)} runs; two threads 'near' where the threads' cache-line round trip was below {near_ns:.0f} ns; "
           "µs per step, fastest run of each class (runs in the class, its round trip).")
     print()
-    print("| scene | nodes | 1 thread | 2 threads near | speed-up near | 2 threads far | speed-up far |")
+    print("| scene | nodes | 1 thread | 2 threads near | speed-up near: fastest; paired median (min–max) | "
+          "2 threads far | speed-up far: fastest; paired median (min–max) |")
     print("|---|---|---|---|---|---|---|")
     for key in sorted(set(one) | set(two)):
         base = min(one[key]) if one[key] else None
@@ -56,7 +69,9 @@ def main():
                 continue
             us, trip = min(runs)
             cells.append(f"{us:.0f} ({len(runs)}; {trip:.0f} ns)")
-            cells.append(f"{base / us:.2f}" if base else "")
+            ratios = paired[key][placement]
+            pair = (f"; {statistics.median(ratios):.2f} ({min(ratios):.2f}–{max(ratios):.2f})" if ratios else "")
+            cells.append(f"{base / us:.2f}{pair}" if base else "")
         print(f"| {key[0]} | {key[1]} | " + " | ".join(cells) + " |")
     return 0
 
