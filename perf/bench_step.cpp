@@ -259,9 +259,16 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 1000));
   app.add_option("--set", o.sets,
                  "KEY=VALUE: a scene key for every case, e.g. --set solver.cg_abs_tol_N=4e-14");
+  bool round_trip_only = false;
+  app.add_flag("--round-trip", round_trip_only,
+               "only measure the two OpenMP threads' cache-line round trip (ns) and print it");
   app.add_flag("--child", o.child, "(internal) run one thread count, no header, no Serial unless --serial");
   app.add_flag("--serial,!--no-serial", o.serial, "also time the Serial space");
   CLI11_PARSE(app, argc, argv);
+  if (round_trip_only) {
+    std::printf("thread_round_trip_ns,%.0f\n", thread_round_trip_ns());
+    return 0;
+  }
   o.scenes.clear();
   std::stringstream ss(scenes);
   for (std::string k; std::getline(ss, k, ',');) {
