@@ -6,7 +6,8 @@ usage: speedup.py RUN.csv [RUN.csv ...] [--near-ns 250]
 bench_step writes, on each two-thread row, the round trip of one cache line between the two OpenMP threads
 (column thread_round_trip_ns). On a VM the host may move the virtual CPUs between dies from one minute to the
 next: on session 23's 2-vCPU Zen 5 VM the round trip was 160-180 ns (same die) or 400-480 ns (two dies), and
-a two-thread step at 10242 nodes took 10-25% longer on two dies. Mixing the two placements in one "fastest of
+a two-thread step at 10242 nodes took 10-15% longer on two dies (medians of the paired speed-ups
+below). Mixing the two placements in one "fastest of
 N runs" hides which one a number belongs to, so this script keeps them apart: for each scene and node count,
 the fastest one-thread step over all runs, and the fastest two-thread step among the runs whose round trip was
 below --near-ns ("near") and among the others ("far"), each with its speed-up and the number of runs behind it;
@@ -34,7 +35,7 @@ def main():
     two = defaultdict(lambda: {"near": [], "far": []})  # (scene, nodes) -> placement -> [(µs, round trip ns)]
     paired = defaultdict(lambda: {"near": [], "far": []})  # (scene, nodes) -> placement -> [1-thread / 2-thread]
     for path in args:
-        in_run = {}  # (scene, nodes, threads) -> (µs, round trip ns) of this run
+        in_run = {}  # (scene, nodes, threads) -> (µs, placement) of this run
         for r in csv.DictReader(open(path)):
             if r["kernel"] != "step" or r["space"] != "OpenMP":
                 continue
@@ -44,14 +45,14 @@ def main():
             us = float(r["us_per_step"])
             if int(r["threads"]) == 1:
                 one[key].append(us)
-                in_run[key + (1,)] = (us, 0.0)
+                in_run[key + (1,)] = (us, None)
             elif int(r["threads"]) == 2:
                 trip = float(r["thread_round_trip_ns"])
-                two[key]["near" if trip < near_ns else "far"].append((us, trip))
-                in_run[key + (2,)] = (us, trip)
-        for (scene, nodes, threads), (us, trip) in in_run.items():
-            if threads == 2 and (scene, nodes, 1) in in_run:
                 placement = "near" if trip < near_ns else "far"
+                two[key][placement].append((us, trip))
+                in_run[key + (2,)] = (us, placement)
+        for (scene, nodes, threads), (us, placement) in in_run.items():
+            if threads == 2 and (scene, nodes, 1) in in_run:
                 paired[(scene, nodes)][placement].append(in_run[(scene, nodes, 1)][0] / us)
     print(f"{len(args)} runs; two threads 'near' where the threads' cache-line round trip was below {near_ns:.0f} ns; "
           "µs per step, fastest run of each class (runs in the class, its round trip).")
