@@ -11,7 +11,8 @@
 namespace dcm {
 namespace {
 
-const char* const kFormat = "dcm-checkpoint-2";  // 2: icosphere nodes numbered for locality (session 22)
+const char* const kFormat =
+    "dcm-checkpoint-3";  // 2: icosphere nodes numbered for locality (session 22); 3: in bands (session 24)
 
 // Closes an HDF5 identifier on scope exit.
 struct Handle {

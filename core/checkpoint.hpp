@@ -4,7 +4,7 @@
 // app each put their own entries ("model.x", "stepper.t", "app.step", ...); the file format is theirs to
 // extend. Plain data here; the HDF5 file is written by write_checkpoint() (dcm_io, core/checkpoint.cpp).
 //
-// File layout: root attribute "format" = "dcm-checkpoint-2"; /arrays/<name> 1-D double datasets;
+// File layout: root attribute "format" = "dcm-checkpoint-3"; /arrays/<name> 1-D double datasets;
 // /texts/<name> variable-length UTF-8 string datasets.
 #include <cstddef>
 #include <map>

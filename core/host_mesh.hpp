@@ -16,8 +16,9 @@ struct HostMesh {
   // Subdivision hierarchy (icosphere and Evans-Fung meshes): the two parent nodes of every node created
   // as an edge midpoint, {-1, -1} for the 12 icosahedron nodes. A node's subdivision level follows from
   // them (0 for the icosahedron, else 1 + the larger of its parents' levels); the nodes of level <= j are
-  // the mesh of subdivision j. The nodes are numbered for locality (in the order the triangles first use
-  // them), not by level. Empty for meshes without such a hierarchy (the multigrid then falls back).
+  // the mesh of subdivision j. The nodes are numbered for locality (in bands across the x axis, breadth
+  // first from the node of largest x; the triangles sorted by their nodes), not by level. Empty for meshes
+  // without such a hierarchy (the multigrid then falls back).
   std::vector<std::array<int, 2>> parents;
 };
 

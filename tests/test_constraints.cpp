@@ -302,7 +302,8 @@ TEST(Constraints, EachCellFeelsOnlyItsOwnAreaAndVolume) {
 
 TEST(Constraints, DegenerateRestShapeIsRejected) {
   HostMesh m = make_icosphere(1, kRadius);
-  m.nodes[12] = m.nodes[0];  // node 12 is the midpoint of an edge of node 0: triangles collapse
+  const Tri& t = m.triangles[0];
+  m.nodes[t[1]] = m.nodes[t[0]];  // two corners of a triangle at one point: triangles collapse
   using Mem = Kokkos::DefaultExecutionSpace::memory_space;
   const Kokkos::DefaultExecutionSpace space;
   const MeshBuffers<Mem> mesh = upload_cells<Mem>({HostCell(m)});

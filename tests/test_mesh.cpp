@@ -1,11 +1,13 @@
 // Mesh generation and topology: counts, closedness, orientation, rings.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <set>
 #include <stdexcept>
 
+#include "apps/common/stretch_setup.hpp"
 #include "core/host_mesh.hpp"
 
 namespace dcm {
@@ -53,6 +55,36 @@ TEST_P(IcosphereLevels, OutwardOrientationAndRadius) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Levels0to6, IcosphereLevels, ::testing::Range(0, 7));
+
+// The optical tweezers' pulled nodes (apps/common/stretch_setup.hpp) depend on the geometry only: the same
+// positions under a reversed numbering, every mirror image of a node taken with it (the icosphere's rings at
+// the ends hold nodes level in x, which a count alone would split by their numbering), at least the fraction.
+TEST(StretchSetup, PulledNodesDoNotDependOnTheNumbering) {
+  for (const HostMesh& m : {make_icosphere(4, 1.0), make_evans_fung(3)}) {
+    HostMesh reversed = m;
+    std::reverse(reversed.nodes.begin(), reversed.nodes.end());
+    const auto positions = [](const HostMesh& mesh, const std::vector<int>& ids) {
+      std::vector<Vec3> p;
+      for (int i : ids) p.push_back(mesh.nodes[i]);
+      std::sort(p.begin(), p.end());
+      return p;
+    };
+    for (const double fraction : {0.025, 0.05}) {
+      const auto [left, right] = pulled_nodes(m, fraction);
+      const auto [left_r, right_r] = pulled_nodes(reversed, fraction);
+      EXPECT_EQ(positions(m, left), positions(reversed, left_r)) << fraction;
+      EXPECT_EQ(positions(m, right), positions(reversed, right_r)) << fraction;
+      EXPECT_GE(left.size(), std::lround(fraction * m.nodes.size()));
+      EXPECT_EQ(left.size(), right.size());  // both meshes are symmetric under x -> -x
+      double x_taken = -1e300;               // every node left out lies further in than every node taken
+      for (int i : left) x_taken = std::max(x_taken, m.nodes[i][0]);
+      for (std::size_t i = 0; i < m.nodes.size(); ++i)
+        if (std::find(left.begin(), left.end(), static_cast<int>(i)) == left.end()) {
+          EXPECT_GT(m.nodes[i][0], x_taken);
+        }
+    }
+  }
+}
 
 TEST(Topology, HingesAreTheTwoTrianglesOfEachEdge) {
   const HostMesh m = make_icosphere(2, 1.0);

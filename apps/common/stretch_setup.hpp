@@ -10,14 +10,24 @@
 
 namespace dcm {
 
-// Node indices of the outermost `fraction` of the nodes at the −x and +x ends (at least one each).
+// Node indices of the outermost `fraction` of the nodes at the −x and +x ends (at least one each). Nodes
+// level with the last one taken (|Δx| within 1e-9 of the cell's length, the mirror images of a symmetric
+// mesh) are taken too, so the choice depends on the geometry only, not on how the nodes are numbered, and
+// each end gets every node of its outermost rings.
 inline std::pair<std::vector<int>, std::vector<int>> pulled_nodes(const HostMesh& m, double fraction) {
   std::vector<int> order(m.nodes.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return m.nodes[a][0] < m.nodes[b][0]; });
   const std::size_t n =
       std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(fraction * m.nodes.size())));
-  return {std::vector<int>(order.begin(), order.begin() + n), std::vector<int>(order.end() - n, order.end())};
+  const double tie = 1e-9 * (m.nodes[order.back()][0] - m.nodes[order.front()][0]);
+  const double low = m.nodes[order[n - 1]][0], high = m.nodes[order[order.size() - n]][0];
+  std::vector<int> left, right;
+  for (std::size_t k = 0; k < order.size() && m.nodes[order[k]][0] <= low + tie; ++k)
+    left.push_back(order[k]);
+  for (std::size_t k = order.size(); k-- > 0 && m.nodes[order[k]][0] >= high - tie;)
+    right.push_back(order[k]);
+  return {left, right};
 }
 
 // Axial (x) and transverse (y) extent of positions [n][3] row major.
