@@ -114,7 +114,7 @@ TEST(Multigrid, IcosphereRecordsItsSubdivisionParents) {
 
 // The nodes are numbered for locality (core/host_mesh.cpp, renumber_in_bands): split into T equal contiguous
 // ranges (the threads' shares of a kernel), the bonds across each split join nodes within 2% of the nodes of
-// the split point, for T = 2 ... 16 (the first-use numbering of session 22: up to 34%), the two halves meet
+// the split point, for T = 2 ... 16 (the first-use numbering of session 22: 49–68%), the two halves meet
 // along about a great circle's bonds (374; first use: 735), and they are the cell's x > 0 and x < 0 halves.
 // A triangle's nodes lie within a short index window.
 TEST(Multigrid, IcosphereNodesAreNumberedForLocality) {
