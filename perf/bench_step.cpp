@@ -22,7 +22,9 @@
 // rows of a table are both from quiet moments (docs/PERFORMANCE.md, "Session 12"). The rows are printed when
 // all rounds are done; with one round they stream as each case finishes.
 // Each OpenMP thread count runs in a child process of this binary (OMP_NUM_THREADS is fixed at Kokkos start);
-// Serial runs once, in the first. CSV on stdout (docs/PERFORMANCE.md turns it into tables).
+// Serial and Cuda run once, in the first. --no-kernel-times leaves the Kokkos Tools callbacks out (no fence
+// around each kernel: on a GPU the fences add a synchronisation per launch) and prints the "step" row alone,
+// with 0 launches. CSV on stdout (docs/PERFORMANCE.md turns it into tables).
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -124,7 +126,7 @@ struct Options {
   std::vector<std::string> scenes{"stretch", "spread", "diagonal"};
   std::vector<int> threads{1, 2};
   int steps = 20, warmup = 5, repeat = 1, rounds = 1;
-  bool child = false, serial = true;
+  bool child = false, serial = true, cuda = true, kernel_times = true;
   std::vector<std::string> sets;  // scene overrides for every case (applied last)
 };
 
@@ -187,6 +189,7 @@ void run_case(const std::string& space_name, int threads, const std::string& kin
     long its = 0;
     const auto t0 = Clock::now();
     for (int s = 0; s < o.steps; ++s) its += stepper.step(model, cg, 1.0, [](double) {}).iterations;
+    Exec().fence();  // a device's last kernels may still run when step() returns
     const double block_s = std::chrono::duration<double>(Clock::now() - t0).count() / o.steps;
     g_times.on = false;
     const double trip_after = threaded ? thread_round_trip_ns() : 0;
@@ -205,13 +208,13 @@ void run_case(const std::string& space_name, int threads, const std::string& kin
   };
   double covered = 0;
   long launches = 0;
-  for (const auto& [name, sec] : best_kernels) {
+  for (const auto& [name, sec] : best_kernels) {  // (empty with --no-kernel-times)
     const long count = best_launches[name];
     row(name, sec / o.steps, static_cast<double>(count) / o.steps);
     covered += sec / o.steps;
     launches += count;
   }
-  row("other", step_s - covered, 0);
+  if (o.kernel_times) row("other", step_s - covered, 0);
   row("step", step_s, static_cast<double>(launches) / o.steps);
   std::fflush(stdout);
 }
@@ -224,7 +227,7 @@ void run_all(const Options& o, int threads) {
       run_case<Kokkos::OpenMP>("OpenMP", threads, kind, level, o);
 #endif
 #if defined(KOKKOS_ENABLE_CUDA)
-      run_case<Kokkos::Cuda>("Cuda", 0, kind, level, o);
+      if (o.cuda) run_case<Kokkos::Cuda>("Cuda", 0, kind, level, o);
 #endif
     }
 }
@@ -264,6 +267,12 @@ int main(int argc, char** argv) {
                "only measure the two OpenMP threads' cache-line round trip (ns) and print it");
   app.add_flag("--child", o.child, "(internal) run one thread count, no header, no Serial unless --serial");
   app.add_flag("--serial,!--no-serial", o.serial, "also time the Serial space");
+  app.add_flag("--cuda,!--no-cuda", o.cuda,
+               "also time the Cuda space (when this Kokkos has it; in the first child only)");
+  app.add_flag(
+      "--kernel-times,!--no-kernel-times", o.kernel_times,
+      "time each kernel (Kokkos fences around every kernel; on a GPU that adds a synchronisation per "
+      "launch to the step); --no-kernel-times: the whole step alone, unfenced");
   CLI11_PARSE(app, argc, argv);
   if (round_trip_only) {
     std::printf("thread_round_trip_ns,%.0f\n", thread_round_trip_ns());
@@ -288,7 +297,7 @@ int main(int argc, char** argv) {
   if (o.child) {
     try {
       dcm::KokkosSession kokkos;
-      install_kernel_timer();
+      if (o.kernel_times) install_kernel_timer();
       run_all(o, std::atoi(std::getenv("OMP_NUM_THREADS") ? std::getenv("OMP_NUM_THREADS") : "0"));
     } catch (const std::exception& e) {
       std::cerr << "bench_step: error: " << e.what() << "\n";
@@ -316,7 +325,9 @@ int main(int argc, char** argv) {
       std::string cmd = "OMP_NUM_THREADS=" + std::to_string(o.threads[k]) + " OMP_PROC_BIND=false '" + self +
                         "' --child --levels " + join(o.levels) + " --scenes " + scenes + " --steps " +
                         std::to_string(o.steps) + " --warmup " + std::to_string(o.warmup) + " --repeat " +
-                        std::to_string(o.repeat) + (k == 0 && o.serial ? " --serial" : " --no-serial");
+                        std::to_string(o.repeat) + (k == 0 && o.serial ? " --serial" : " --no-serial") +
+                        (k == 0 && o.cuda ? " --cuda" : " --no-cuda") +
+                        (o.kernel_times ? "" : " --no-kernel-times");
       for (const std::string& set : o.sets) cmd += " --set '" + set + "'";
       const auto failed = [&] {
         std::cerr << "bench_step: error: the run with " << o.threads[k] << " OpenMP threads failed\n";

@@ -15,7 +15,8 @@ case "$preset" in
 esac
 # debug uses a Kokkos with bounds checking on every View access; sanitize the release Kokkos (ASan and UBSan
 # instrument dcm's own code; the bounds checks would make the sanitized suite ~100x slower than release).
-# cuda: Kokkos with CUDA (DCM_CUDA_ARCH, default AMPERE80; scripts/deps.sh), dcm compiled by its nvcc_wrapper.
+# cuda: Kokkos with CUDA (DCM_CUDA_ARCH, default AMPERE80; HOPPER90 for an H100/H200; scripts/deps.sh), dcm
+# compiled by its nvcc_wrapper.
 kokkos=$(DCM_KOKKOS_VARIANT=$kokkos_variant bash scripts/deps.sh | tail -n 1)
 extra=()
 if [ "$preset" = cuda ]; then
