@@ -42,8 +42,8 @@ fi
 # Kokkos' nvcc_wrapper. It needs nvcc: in $CUDA_HOME/bin, on PATH or in /usr/local/cuda/bin, from CUDA 11.x
 # (Kokkos 3.4.1 predates CUDA 12; with CUDA 12 or newer, point Kokkos_ROOT at a Kokkos 4.x). HOPPER90 (H100,
 # H200; CUDA 11.8 compiles sm_90) is not one of Kokkos 3.4.1's names: it is added to a copy of the source
-# (three lines, below). Kokkos 3.4.1 refuses to start when the device's compute capability has another major
-# number than the code's, so AMPERE80 code (PTX JIT-compiled by the driver) does not run on a Hopper GPU.
+# (scripts/kokkos_add_hopper.sh). Kokkos 3.4.1 refuses to start when the device's compute capability has
+# another major number than the code's, so AMPERE80 code does not run on a Hopper GPU.
 variant=${DCM_KOKKOS_VARIANT:-release}
 backends="Serial+OpenMP"
 case "$variant" in
@@ -107,15 +107,12 @@ else
 fi
 mkdir -p "$cache"
 buildlog="$cache/kokkos-3.4.1-$variant-build.log"
-# HOPPER90: Kokkos 3.4.1 with the architecture added (an option, its nvcc flag sm_90, its config macro), in a
-# patched copy of the source; the cached source stays as Debian ships it.
+# HOPPER90: Kokkos 3.4.1 with the architecture added (scripts/kokkos_add_hopper.sh), in a copy of the source;
+# the cached source stays as Debian ships it.
 if [ "$variant" = cuda ] && [ "$arch" = HOPPER90 ]; then
   cp -r "$ksrc" "$work/kokkos-hopper"
   ksrc="$work/kokkos-hopper"
-  sed -i -e '/^KOKKOS_ARCH_OPTION(AMPERE86 /a KOKKOS_ARCH_OPTION(HOPPER90        GPU  "NVIDIA Hopper generation CC 9.0")' \
-    -e '/^CHECK_CUDA_ARCH(AMPERE86 /a CHECK_CUDA_ARCH(HOPPER90  sm_90)' "$ksrc/cmake/kokkos_arch.cmake"
-  sed -i '/^#cmakedefine KOKKOS_ARCH_AMPERE86/a #cmakedefine KOKKOS_ARCH_HOPPER90' "$ksrc/cmake/KokkosCore_config.h.in"
-  [ "$(grep -c HOPPER90 "$ksrc/cmake/kokkos_arch.cmake")" = 2 ] || { log "error: could not add HOPPER90 to $ksrc/cmake/kokkos_arch.cmake"; exit 1; }
+  bash "$(dirname "$0")/kokkos_add_hopper.sh" "$ksrc" || { log "error: could not add HOPPER90 to $ksrc"; exit 1; }
 fi
 # With CUDA, Kokkos and every code that includes it compile through Kokkos' nvcc_wrapper (installed to
 # $prefix/bin).
