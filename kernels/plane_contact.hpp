@@ -1,51 +1,22 @@
 #pragma once
 // Adhesive contact of the rounded triangles with a plane (paper eqs. 15–19, MODEL.md section 4;
-// docs/model/contact.md). Per triangle t whose encompassing sphere (centre O_t, radius R_t;
-// kernels/rounded_triangle.hpp) comes within h0 of the plane and that faces the plane:
-//   overlap δ = R_t − dist(O_t, plane); Maugis–Dugdale state for (δ, R_t) (kernels/maugis_dugdale.hpp);
-//   contact centre C = the foot of O_t on the plane;
-//   regime 1, π c² ≥ 2 A_t / N_Q (eq. 18): the pressure p(r) integrated over the triangle by the N_Q-point
-//     rule, force F_t (eq. 16) and moment M_t about C (eq. 17);
-//   regime 2, a small disc: the net MD load times the fraction of the disc inside the triangle's
-//     projection, applied at C (or the nearest point of the triangle);
-//   distribution to the three nodes by the 3×3 solve of eq. 19 (kernels/contact_distribution.hpp).
-// The per-triangle results are kept (node loads, β weights for the substrate friction, contact area) and
-// gathered per node without atomics through the node → triangle-corner lists.
-// A cell with contact.law = "derjaguin" takes another branch per triangle: flat triangles with the exact
-// gradient of the Derjaguin energy (kernels/derjaguin_adhesion.hpp, docs/model/contact_line.md), which adds
-// in-plane node forces (tri_node_shear).
+// docs/model/contact.md): the kernels over a mesh. What one triangle computes is in
+// kernels/plane_contact_triangle.hpp; here the stages run as kernels:
+//   dcm::contact::broad       every triangle: its rows cleared, the broad phase (tri_branch);
+//   dcm::contact::candidates  the triangles through it, listed (a scan; their count comes to the host);
+//   dcm::contact::md_state    the listed rounded triangles: Maugis–Dugdale state (tri_md) and narrow branch;
+//   dcm::contact::polar, ::rule, ::disc, ::derjaguin
+//                             the listed triangles of that branch: the pressure integrated, distributed to
+//                             the nodes (eq. 19), the rows written. Only the branches the parameters can
+//                             take are launched.
+// Splitting the stages keeps each GPU kernel to its own branch's registers (one kernel for all took 255
+// registers and spilled on sm_90: docs/PERFORMANCE.md "Backends") and lets the narrow phase run over the
+// contact patch only. The per-triangle results are kept (node loads, β weights for the substrate friction,
+// contact area) and gathered per node without atomics through the node → triangle-corner lists.
 #include "core/cell_params.hpp"
-#include "core/geometry.hpp"
-#include "core/vec3.hpp"
-#include "kernels/contact_distribution.hpp"
-#include "kernels/derjaguin_adhesion.hpp"
-#include "kernels/maugis_dugdale.hpp"
-#include "kernels/polar_contact_integral.hpp"
-#include "kernels/quadrature_rules.hpp"
+#include "kernels/plane_contact_triangle.hpp"
 
 namespace dcm {
-
-// The plane {x : (x − point)·normal = 0}; the cells live on the side the unit normal points to.
-struct Plane {
-  Real3 point{0, 0, 0};
-  Real3 normal{0, 0, 1};
-};
-
-struct PlaneContactParams {
-  MdMaterial material{};       // K = 4/3 E/(1 − ν²), W, h0
-  int quadrature_points = 0;   // 0: exact polar integration (dcm); 1, 3, 7 or 16: the paper's rules (eq. 18)
-  bool projected_area = true;  // quadrature weights × the triangle's area projected on the plane (else A_t)
-  // Substrate friction acts on the triangle's area within r < max(a, c) (contact and adhesive zone; dcm's
-  // default, docs/model/contact.md) or, as the paper writes, within the contact radius a only.
-  bool friction_on_adhesive_zone = true;
-  // contact.law = "derjaguin": flat triangles with the Derjaguin energy of kernels/derjaguin_adhesion.hpp
-  // (forces in and out of the plane) instead of the rounded triangles' Maugis–Dugdale pressure.
-  bool derjaguin = false;
-};
-
-// What a triangle's contact is doing (tri_regime).
-// kFullContact: the whole (projected) triangle lies within the contact radius a.
-enum ContactRegime : int { kNoContact = 0, kGap = 1, kQuadrature = 2, kSmallDisc = 3, kFullContact = 4 };
 
 template <class MemorySpace>
 struct ContactBuffers {
@@ -64,6 +35,12 @@ struct ContactBuffers {
   // In-plane force on each corner's node (N), from contact.law = "derjaguin" only; empty otherwise (the
   // rounded triangles' forces are along the plane normal).
   View<double* [3][3]> tri_node_shear;
+  // The stages' scratch (kernels/plane_contact_triangle.hpp): each triangle's ContactBranch (a row
+  // is non-zero only where it is not kBranchNone), the Maugis–Dugdale state of the rounded triangles through
+  // the broad phase (a, c, δ, P, p0, σ0), and the list of the triangles through the broad phase.
+  View<int*> tri_branch;
+  View<double* [6]> tri_md;
+  View<int*> candidates;
 
   ContactBuffers() = default;
   ContactBuffers(int n_tris, bool in_plane_forces) : ContactBuffers(n_tris) {
@@ -76,209 +53,170 @@ struct ContactBuffers {
         tri_contact_area("dcm::contact::tri_contact_area", n_tris),
         tri_friction_area("dcm::contact::tri_friction_area", n_tris),
         tri_load("dcm::contact::tri_load", n_tris),
-        tri_regime("dcm::contact::tri_regime", n_tris) {}
+        tri_regime("dcm::contact::tri_regime", n_tris),
+        tri_branch("dcm::contact::tri_branch", n_tris),
+        tri_md("dcm::contact::tri_md", n_tris),
+        candidates("dcm::contact::candidates", n_tris) {}
 };
 
-// Fraction of a disc of radius c centred at C inside the triangle (p0, p1, p2), all in the plane: the
-// product of the fractions on the inner side of each edge's line (exact for a disc that crosses one
-// edge; shared discs near a vertex are split approximately).
-KOKKOS_INLINE_FUNCTION double disc_fraction_in_triangle(Real3 p0, Real3 p1, Real3 p2, Real3 C, Real3 n,
-                                                        double c) {
-  const Real3 p[3] = {p0, p1, p2};
-  const double orient = dot(cross(p1 - p0, p2 - p0), n) >= 0 ? 1.0 : -1.0;
-  double fraction = 1;
-  for (int e = 0; e < 3; ++e) {
-    const Real3 a = p[e], b = p[(e + 1) % 3];
-    const Real3 inward = orient * cross(n, b - a);  // in the plane, towards the triangle's inside
-    const double len = norm(inward);
-    if (!(len > 0)) continue;
-    const double s = math::min(math::max(dot(C - a, inward) / (len * c), -1.0), 1.0);
-    fraction *= 1.0 - (math::acos(s) - s * math::sqrt(1.0 - s * s)) / kMdPi;
+namespace contact_detail {
+template <class MemorySpace>
+KOKKOS_INLINE_FUNCTION void store(const ContactBuffers<MemorySpace>& out, int t, const TriangleContact& c) {
+  for (int k = 0; k < 3; ++k) {
+    out.tri_node_load(t, k) = c.node_load[k];
+    out.tri_beta(t, k) = c.beta[k];
+    out.tri_area_weight(t, k) = c.area_weight[k];
   }
-  return fraction;
+  out.tri_contact_area(t) = c.contact_area;
+  out.tri_friction_area(t) = c.friction_area;
+  out.tri_load(t) = c.load;
+  out.tri_regime(t) = c.regime;
+  if (out.tri_node_shear.extent(0) > 0)
+    for (int k = 0; k < 3; ++k) {
+      out.tri_node_shear(t, k, 0) = c.shear[k].x;
+      out.tri_node_shear(t, k, 1) = c.shear[k].y;
+      out.tri_node_shear(t, k, 2) = c.shear[k].z;
+    }
 }
 
-// The point of triangle (p0, p1, p2) nearest to C, all in one plane (C itself when inside).
-KOKKOS_INLINE_FUNCTION Real3 nearest_point_in_triangle(Real3 p0, Real3 p1, Real3 p2, Real3 C, Real3 n) {
-  const Real3 p[3] = {p0, p1, p2};
-  const double orient = dot(cross(p1 - p0, p2 - p0), n) >= 0 ? 1.0 : -1.0;
-  bool inside = true;
-  for (int e = 0; e < 3; ++e)
-    if (orient * dot(cross(p[(e + 1) % 3] - p[e], C - p[e]), n) < 0) inside = false;
-  if (inside) return C;
-  Real3 best = p0;
-  double best_d2 = norm2(C - p0);
-  for (int e = 0; e < 3; ++e) {
-    const Real3 a = p[e], d = p[(e + 1) % 3] - a;
-    const double dd = norm2(d);
-    const double t = dd > 0 ? math::min(math::max(dot(C - a, d) / dd, 0.0), 1.0) : 0.0;
-    const Real3 q = a + t * d;
-    if (norm2(C - q) < best_d2) {
-      best_d2 = norm2(C - q);
-      best = q;
-    }
-  }
-  return best;
+template <class View>
+KOKKOS_INLINE_FUNCTION MdState load_md(const View& md, int t) {
+  MdState st;
+  st.a = md(t, 0);
+  st.c = md(t, 1);
+  st.delta = md(t, 2);
+  st.P = md(t, 3);
+  st.p0 = md(t, 4);
+  st.sigma0 = md(t, 5);
+  return st;
 }
+
+// Dynamic chunks: the triangles in contact are one patch of the mesh, which a static split hands to one
+// thread (2 threads, 2562 nodes pressed 1 µm: 1.8 → 1.3 ms per step; docs/PERFORMANCE.md "Session 11").
+// Each triangle's results depend on that triangle only, so the schedule changes no bit.
+template <class ExecutionSpace>
+using DynamicRange = Kokkos::RangePolicy<ExecutionSpace, Kokkos::Schedule<Kokkos::Dynamic>>;
+
+// The listed triangles (the first `count` of out.candidates) of one narrow-phase branch: f(t) returns the
+// triangle's TriangleContact.
+template <class ExecutionSpace, class MemorySpace, class F>
+void narrow_phase(const char* label, const ExecutionSpace& space, const ContactBuffers<MemorySpace>& out,
+                  int count, int branch, const F& f) {
+  const auto list = out.candidates;
+  const auto tri_branch = out.tri_branch;
+  Kokkos::parallel_for(
+      label, DynamicRange<ExecutionSpace>(space, 0, count, Kokkos::ChunkSize(8)), KOKKOS_LAMBDA(const int i) {
+        const int t = list(i);
+        if (tri_branch(t) == branch) store(out, t, f(t));
+      });
+}
+}  // namespace contact_detail
 
 // Per-triangle contact with the plane (needs update_geometry(): tri_area, tri_normal, the spheres).
 // params: one PlaneContactParams or a CellTable of them (PerCell::table(), core/cell_params.hpp).
+// branches: the narrow-phase kernels to launch (plane_contact_branches(); the overloads below find them from
+// the parameters); a triangle of a branch left out keeps the rows of no contact.
 template <class ExecutionSpace, class MemorySpace, class Params>
 void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                            const GeometryBuffers<MemorySpace>& geo, const Plane& plane, const Params& params,
-                           const ContactBuffers<MemorySpace>& out) {
+                           const ContactBuffers<MemorySpace>& out, int branches) {
   const auto x = mesh.x;
   const auto tri = mesh.tri;
+  const auto tri_cell = mesh.tri_cell;
   const auto tri_area = geo.tri_area;
   const auto tri_normal = geo.tri_normal;
   const auto center = geo.tri_sphere_center;
   const auto radius = geo.tri_sphere_radius;
-  const auto node_load = out.tri_node_load;
-  const auto beta = out.tri_beta;
-  const auto area_weight = out.tri_area_weight;
-  const auto contact_area = out.tri_contact_area;
-  const auto friction_area = out.tri_friction_area;
-  const auto load = out.tri_load;
-  const auto regime = out.tri_regime;
-  const auto shear = out.tri_node_shear;
-  const bool has_shear = shear.extent(0) > 0;
-  const double len = norm(plane.normal);
-  const Real3 n = (1.0 / len) * plane.normal, p_plane = plane.point;
-  const auto tri_cell = mesh.tri_cell;
-  // Dynamic chunks: the triangles in contact are one patch of the mesh, which a static split hands to one
-  // thread (2 threads, 2562 nodes pressed 1 µm: 1.8 → 1.3 ms per step; docs/PERFORMANCE.md "Session 11").
-  // Each triangle's results depend on that triangle only, so the schedule changes no bit.
+  const auto tri_branch = out.tri_branch;
+  const auto md = out.tri_md;
+  const auto list = out.candidates;
+  const Real3 n = (1.0 / norm(plane.normal)) * plane.normal, p = plane.point;
+  // Broad phase; the rows of the last call's contacts cleared (every other row is zero already).
   Kokkos::parallel_for(
-      "dcm::contact::plane",
-      Kokkos::RangePolicy<ExecutionSpace, Kokkos::Schedule<Kokkos::Dynamic>>(space, 0, mesh.n_tris,
-                                                                             Kokkos::ChunkSize(32)),
+      "dcm::contact::broad", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_tris),
       KOKKOS_LAMBDA(const int t) {
-        for (int k = 0; k < 3; ++k) {
-          node_load(t, k) = 0;
-          beta(t, k) = 0;
-          area_weight(t, k) = 0;
-        }
-        contact_area(t) = 0;
-        friction_area(t) = 0;
-        load(t) = 0;
-        regime(t) = kNoContact;
-        if (has_shear)
-          for (int k = 0; k < 3; ++k)
-            for (int d = 0; d < 3; ++d) shear(t, k, d) = 0;
-        const PlaneContactParams prm = cell_value(params, tri_cell(t));
-        const Real3 x0 = load3(x, tri(t, 0)), x1 = load3(x, tri(t, 1)), x2 = load3(x, tri(t, 2));
-        if (prm.derjaguin) {  // flat triangles, the Derjaguin energy's exact gradient
-          const DerjaguinLaw law{prm.material.W, prm.material.h0, prm.material.K};
-          const DerjaguinTriangle dt = derjaguin_triangle(law, x0, x1, x2, p_plane, n);
-          const double fa = prm.friction_on_adhesive_zone ? dt.zone_area : dt.contact_area;
-          const double* w = prm.friction_on_adhesive_zone ? dt.zone_weight : dt.contact_weight;
-          double total = 0;
-          for (int k = 0; k < 3; ++k) {
-            node_load(t, k) = dt.normal_force[k];
-            total += dt.normal_force[k];
-            beta(t, k) = fa > 0 ? w[k] : 1.0 / 3.0;
-            area_weight(t, k) = beta(t, k);
-            if (has_shear) {
-              shear(t, k, 0) = dt.shear[k].x;
-              shear(t, k, 1) = dt.shear[k].y;
-              shear(t, k, 2) = dt.shear[k].z;
-            }
-          }
-          load(t) = total;
-          contact_area(t) = dt.contact_area;
-          friction_area(t) = fa;
-          if (dt.contact_area > 0)
-            regime(t) = dt.highest < derjaguin_contact_gap(law) ? kFullContact : kQuadrature;
-          else if (dt.zone_area > 0)
-            regime(t) = kGap;
-          return;
-        }
-        const double R = radius(t);
-        const Real3 O = load3(center, t);
-        const double height = dot(O - p_plane, n);  // of the sphere centre
-        const double delta = R - height;
-        // Broad phase: the sphere within h0, the triangle facing the plane, and the triangle itself
-        // within h0 plus its size of the plane (a flat triangle far above has a huge sphere too).
-        if (!(delta > -prm.material.h0) || !(dot(load3(tri_normal, t), n) < 0)) return;
-        const double span = math::max(math::max(norm(x1 - x0), norm(x2 - x1)), norm(x0 - x2));
-        const double lowest =
-            math::min(math::min(dot(x0 - p_plane, n), dot(x1 - p_plane, n)), dot(x2 - p_plane, n));
-        if (!(lowest < prm.material.h0 + span)) return;
-        const MdState st = md_state_from_overlap(delta, R, prm.material);
-        const double outer = math::max(st.a, st.c);
-        if (!(outer > 0)) return;
-        const Real3 C = O - height * n;
-        const double area_t = tri_area(t);
-        const double area_q = prm.projected_area ? 0.5 * math::fabs(dot(cross(x1 - x0, x2 - x0), n)) : area_t;
-        double Fn = 0, a_contact = 0, a_zone = 0;
-        double lam_friction[3] = {-1, 0, 0};  // the friction area's centroid in barycentric coordinates
-        Real3 M{0, 0, 0}, C_apply = C;
-        const int nq = prm.quadrature_points;
-        if (nq == 0) {  // exact in r, Gauss in θ (kernels/polar_contact_integral.hpp); no regimes needed
-          const Real3 ref = math::fabs(n.x) < 0.9 ? Real3{1, 0, 0} : Real3{0, 1, 0};
-          Real3 e1 = cross(ref, n);
-          e1 = (1.0 / norm(e1)) * e1;
-          const Real3 e2 = cross(n, e1);
-          const PolarIntegral pi = polar_contact_integral(st, x0, x1, x2, C, e1, e2);
-          Fn = pi.load;
-          M = pi.m1 * e1 + pi.m2 * e2;
-          a_contact = pi.contact_area;
-          a_zone = pi.zone_area;
-          const double fa = prm.friction_on_adhesive_zone ? a_zone : a_contact;
-          if (fa > 1e-9 * area_q) {  // (a sliver's moments are rounding noise; its friction is negligible)
-            const double mx = prm.friction_on_adhesive_zone ? pi.zone_x : pi.contact_x,
-                         my = prm.friction_on_adhesive_zone ? pi.zone_y : pi.contact_y;
-            projected_barycentric(x0, x1, x2, C + (mx / fa) * e1 + (my / fa) * e2, n, lam_friction);
-          }
-          regime(t) = st.a > 0 ? kQuadrature : kGap;
-        } else if (kMdPi * outer * outer * nq >= 2.0 * area_t) {  // eq. 18, regime 1: quadrature (eqs. 16–17)
-          integrate_pressure(
-              x0, x1, x2, C, n, area_q, nq, [&](Real3 r) { return md_pressure(st, norm(r)); }, Fn, M);
-          double inside = 0, in_zone = 0, moment[3] = {0, 0, 0};
-          for (int q = 0; q < nq; ++q) {
-            double l1, l2, l3, w;
-            quadrature_point(nq, q, l1, l2, l3, w);
-            const Real3 rel = l1 * x0 + l2 * x1 + l3 * x2 - C;
-            const Real3 r = rel - dot(rel, n) * n;
-            const bool in_a = norm2(r) < st.a * st.a, in_c = norm2(r) < outer * outer;
-            if (in_a) inside += w;
-            if (in_c) in_zone += w;
-            if (prm.friction_on_adhesive_zone ? in_c : in_a) {
-              moment[0] += w * l1;
-              moment[1] += w * l2;
-              moment[2] += w * l3;
-            }
-          }
-          a_contact = inside * area_q;
-          a_zone = in_zone * area_q;
-          const double fw = prm.friction_on_adhesive_zone ? in_zone : inside;
-          if (fw > 1e-9)
-            for (int k = 0; k < 3; ++k) lam_friction[k] = moment[k] / fw;
-          regime(t) = st.a > 0 ? kQuadrature : kGap;
-        } else {  // regime 2: the disc's share of the net load, at C or the triangle's nearest point
-          const Real3 q0 = x0 - dot(x0 - C, n) * n, q1 = x1 - dot(x1 - C, n) * n,
-                      q2 = x2 - dot(x2 - C, n) * n;
-          const double fraction = disc_fraction_in_triangle(q0, q1, q2, C, n, outer);
-          Fn = fraction * st.P;
-          a_contact = fraction * kMdPi * st.a * st.a;
-          a_zone = fraction * kMdPi * outer * outer;
-          C_apply = nearest_point_in_triangle(q0, q1, q2, C, n);
-          projected_barycentric(x0, x1, x2, C_apply, n, lam_friction);
-          regime(t) = st.a > 0 ? kSmallDisc : kGap;
-        }
-        const NodeLoads nl = distribute_normal_load(x0, x1, x2, C_apply, n, Fn, M);  // eq. 19
-        for (int k = 0; k < 3; ++k) {
-          node_load(t, k) = nl.f[k];
-          beta(t, k) = nl.beta[k];
-          area_weight(t, k) = lam_friction[0] >= 0 ? lam_friction[k] : 1.0 / 3.0;
-        }
-        load(t) = Fn;
-        contact_area(t) =
-            math::max(a_contact, 0.0);  // the exact integral of an empty overlap can round to -1e-28
-        friction_area(t) = prm.friction_on_adhesive_zone ? a_zone : a_contact;
-        const double projected = 0.5 * math::fabs(dot(cross(x1 - x0, x2 - x0), n));
-        if (a_contact >= (1 - 1e-9) * projected && projected > 0) regime(t) = kFullContact;
+        if (tri_branch(t) != kBranchNone) contact_detail::store(out, t, TriangleContact{});
+        tri_branch(t) =
+            contact_broad_phase(cell_value(params, tri_cell(t)), load3(x, tri(t, 0)), load3(x, tri(t, 1)),
+                                load3(x, tri(t, 2)), load3(center, t), radius(t), load3(tri_normal, t), p, n);
       });
+  int count = 0;
+  Kokkos::parallel_scan(
+      "dcm::contact::candidates", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_tris),
+      KOKKOS_LAMBDA(const int t, int& offset, const bool final) {
+        if (tri_branch(t) == kBranchNone) return;
+        if (final) list(offset) = t;
+        ++offset;
+      },
+      count);
+  if (count == 0) return;
+  if (branches & (branch_bit(kBranchPolar) | branch_bit(kBranchRule) | branch_bit(kBranchDisc)))
+    Kokkos::parallel_for(
+        "dcm::contact::md_state",
+        contact_detail::DynamicRange<ExecutionSpace>(space, 0, count, Kokkos::ChunkSize(8)),
+        KOKKOS_LAMBDA(const int i) {
+          const int t = list(i);
+          if (tri_branch(t) != kBranchMaugisDugdale) return;
+          const PlaneContactParams prm = cell_value(params, tri_cell(t));
+          const MdState st = md_contact_state(prm, load3(center, t), radius(t), p, n);
+          md(t, 0) = st.a;
+          md(t, 1) = st.c;
+          md(t, 2) = st.delta;
+          md(t, 3) = st.P;
+          md(t, 4) = st.p0;
+          md(t, 5) = st.sigma0;
+          tri_branch(t) = md_contact_branch(prm, st, tri_area(t));
+        });
+  if (branches & branch_bit(kBranchPolar))
+    contact_detail::narrow_phase(
+        "dcm::contact::polar", space, out, count, kBranchPolar, KOKKOS_LAMBDA(const int t) {
+          const PlaneContactParams prm = cell_value(params, tri_cell(t));
+          const Real3 x0 = load3(x, tri(t, 0)), x1 = load3(x, tri(t, 1)), x2 = load3(x, tri(t, 2));
+          return polar_triangle_contact(prm, contact_detail::load_md(md, t), x0, x1, x2,
+                                        contact_centre(load3(center, t), p, n), n,
+                                        quadrature_area(prm, x0, x1, x2, n, tri_area(t)));
+        });
+  if (branches & branch_bit(kBranchRule))
+    contact_detail::narrow_phase(
+        "dcm::contact::rule", space, out, count, kBranchRule, KOKKOS_LAMBDA(const int t) {
+          const PlaneContactParams prm = cell_value(params, tri_cell(t));
+          const Real3 x0 = load3(x, tri(t, 0)), x1 = load3(x, tri(t, 1)), x2 = load3(x, tri(t, 2));
+          return rule_triangle_contact(prm, contact_detail::load_md(md, t), x0, x1, x2,
+                                       contact_centre(load3(center, t), p, n), n,
+                                       quadrature_area(prm, x0, x1, x2, n, tri_area(t)));
+        });
+  if (branches & branch_bit(kBranchDisc))
+    contact_detail::narrow_phase(
+        "dcm::contact::disc", space, out, count, kBranchDisc, KOKKOS_LAMBDA(const int t) {
+          return disc_triangle_contact(cell_value(params, tri_cell(t)), contact_detail::load_md(md, t),
+                                       load3(x, tri(t, 0)), load3(x, tri(t, 1)), load3(x, tri(t, 2)),
+                                       contact_centre(load3(center, t), p, n), n);
+        });
+  if (branches & branch_bit(kBranchDerjaguin))
+    contact_detail::narrow_phase(
+        "dcm::contact::derjaguin", space, out, count, kBranchDerjaguin, KOKKOS_LAMBDA(const int t) {
+          return derjaguin_triangle_contact(cell_value(params, tri_cell(t)), load3(x, tri(t, 0)),
+                                            load3(x, tri(t, 1)), load3(x, tri(t, 2)), p, n);
+        });
+}
+
+// One set of parameters for every cell.
+template <class ExecutionSpace, class MemorySpace>
+void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                           const GeometryBuffers<MemorySpace>& geo, const Plane& plane,
+                           const PlaneContactParams& params, const ContactBuffers<MemorySpace>& out) {
+  compute_plane_contact(space, mesh, geo, plane, params, out, plane_contact_branches(params));
+}
+
+// Each cell its own (the branches from the host rows).
+template <class ExecutionSpace, class MemorySpace>
+void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                           const GeometryBuffers<MemorySpace>& geo, const Plane& plane,
+                           const PerCell<PlaneContactParams, MemorySpace>& params,
+                           const ContactBuffers<MemorySpace>& out) {
+  int branches = 0;
+  for (const PlaneContactParams& p : params.host) branches |= plane_contact_branches(p);
+  compute_plane_contact(space, mesh, geo, plane, params.table(), out, branches);
 }
 
 // A node all of whose triangles lie fully in the contact (the paper's pinned nodes).

@@ -1,7 +1,8 @@
 // The plane-contact kernel (kernels/plane_contact.hpp) per call, for a rigid icosphere of radius 3.25 µm
 // pressed into the plane to a contact radius a = R/2 with Table 1's contact law (E = 800 kPa, ν = 0.4,
 // W = 1 mJ/m², h0 = 20 nm), for the exact polar integration (rule 0) and the paper's 1-, 3-, 7-, 16-point
-// rules; and the node gather.
+// rules (the broad phase, the candidates' list, the Maugis–Dugdale states and the narrow phase); and the
+// node gather.
 //   build/bin/bench_contact [--benchmark_filter=...]
 // Reported: time per call, "contact_triangles" (triangles with a non-zero load) and
 // "ns_per_contact_triangle" (the call's time over them; the other triangles cost a broad-phase test only).

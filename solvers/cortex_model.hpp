@@ -343,7 +343,7 @@ class CortexModel {
     add_external_forces(space_, external_, force_);
     if (gravity_) add_external_forces(space_, *gravity_, force_);
     if (contact_) {
-      compute_plane_contact(space_, mesh_, geo_, params_.plane, contact_params_.table(), *contact_);
+      compute_plane_contact(space_, mesh_, geo_, params_.plane, contact_params_, *contact_);
       add_plane_contact_forces(space_, mesh_, params_.plane, *contact_, force_);
     }
     const int bad_node = first_non_finite_node(space_, force_);

@@ -528,5 +528,101 @@ TEST(PlaneContactEdges, NeedleAndCollapsedTrianglesInTheContactStayFinite) {
     }
   }
 }
+
+// Largest difference between the rows a kernel wrote and the reference's, relative to the largest magnitude.
+template <class View>
+double rows_difference(const View& kernel, const std::vector<double>& reference) {
+  const auto h = to_host_vector(kernel);
+  double scale = 0, worst = 0;
+  for (std::size_t i = 0; i < h.size(); ++i) {
+    scale = std::fmax(scale, std::fmax(std::fabs(h[i]), std::fabs(reference[i])));
+    worst = std::fmax(worst, std::fabs(h[i] - reference[i]));
+  }
+  return scale > 0 ? worst / scale : worst;
+}
+
+// The contact kernels (a kernel per stage and per narrow-phase branch over the broad phase's list) compute
+// what triangle_contact() computes for each triangle in one call, for a batch of three cells that takes
+// every branch: the exact polar integral, the 1-point rule with its small discs (a coarse mesh), and the
+// Derjaguin law. The cells are then lifted until most and then all of the last call's contacts end: the
+// kernels clear only the rows of the last call's contacts, so a row left over would show.
+TEST(PlaneContact, KernelsComputeEveryTrianglesStagesInOneCall) {
+  std::vector<HostCell> cells;
+  for (int c = 0; c < 3; ++c) cells.emplace_back(make_icosphere(2, kR));
+  const MeshBuffers<Mem> mesh = upload_cells<Mem>(cells);
+  const GeometryBuffers<Mem> geo(mesh);
+  PlaneContactParams polar, rule, derjaguin;
+  polar.material = rule.material = derjaguin.material = md_material(kE, kNu, kW, 20e-9);
+  rule.quadrature_points = 1;
+  derjaguin.derjaguin = true;
+  const std::vector<PlaneContactParams> rows{polar, rule, derjaguin};
+  const PerCell<PlaneContactParams, Mem> params(rows);
+  const ContactBuffers<Mem> contact(mesh.n_tris, true);
+  const auto x_start = to_host_vector(mesh.x);
+  const auto node_cell = to_host_vector(mesh.node_cell);
+  const auto tri = to_host_vector(mesh.tri);
+  const auto tri_cell = to_host_vector(mesh.tri_cell);
+  const Exec space;
+  int seen[6] = {0, 0, 0, 0, 0, 0};
+  // Cell c is pressed overlap·(1 + c/4) into the plane.
+  for (double overlap : {0.4e-6, 0.05e-6, 5e-9, -0.1e-6}) {
+    auto h = Kokkos::create_mirror_view(mesh.x);
+    for (int i = 0; i < mesh.n_nodes; ++i)
+      for (int d = 0; d < 3; ++d)
+        h(i, d) = x_start[3 * i + d] + (d == 2 ? kR - overlap * (1 + 0.25 * node_cell[i]) : 0.0);
+    Kokkos::deep_copy(mesh.x, h);
+    update_geometry(space, mesh, geo, 1e4);
+    compute_plane_contact(space, mesh, geo, Plane{}, params, contact);
+    // The reference: every stage of each triangle in one call, on the host.
+    const auto x = to_host_vector(mesh.x), centre = to_host_vector(geo.tri_sphere_center),
+               radius = to_host_vector(geo.tri_sphere_radius), normal = to_host_vector(geo.tri_normal),
+               area = to_host_vector(geo.tri_area);
+    const auto at3 = [](const std::vector<double>& v, int i) {
+      return Real3{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+    };
+    std::vector<double> node_load, beta, weight, contact_area, friction_area, load, shear;
+    std::vector<int> regime, branch;
+    for (int t = 0; t < mesh.n_tris; ++t) {
+      int b = kBranchNone;
+      const TriangleContact c = triangle_contact(
+          rows[tri_cell[t]], at3(x, tri[3 * t]), at3(x, tri[3 * t + 1]), at3(x, tri[3 * t + 2]),
+          at3(centre, t), radius[t], at3(normal, t), area[t], Plane{}.point, Plane{}.normal, b);
+      for (int k = 0; k < 3; ++k) {
+        node_load.push_back(c.node_load[k]);
+        beta.push_back(c.beta[k]);
+        weight.push_back(c.area_weight[k]);
+        for (double v : {c.shear[k].x, c.shear[k].y, c.shear[k].z}) shear.push_back(v);
+      }
+      contact_area.push_back(c.contact_area);
+      friction_area.push_back(c.friction_area);
+      load.push_back(c.load);
+      regime.push_back(c.regime);
+      branch.push_back(b);
+    }
+    const std::string at = "overlap " + std::to_string(overlap * 1e9) + " nm";
+    EXPECT_LE(rows_difference(contact.tri_node_load, node_load), 1e-12) << at;
+    EXPECT_LE(rows_difference(contact.tri_beta, beta), 1e-12) << at;
+    EXPECT_LE(rows_difference(contact.tri_area_weight, weight), 1e-12) << at;
+    EXPECT_LE(rows_difference(contact.tri_contact_area, contact_area), 1e-12) << at;
+    EXPECT_LE(rows_difference(contact.tri_friction_area, friction_area), 1e-12) << at;
+    EXPECT_LE(rows_difference(contact.tri_load, load), 1e-12) << at;
+    EXPECT_LE(rows_difference(contact.tri_node_shear, shear), 1e-12) << at;
+    EXPECT_EQ(to_host_vector(contact.tri_regime), regime) << at;
+    EXPECT_EQ(to_host_vector(contact.tri_branch), branch) << at;
+    int taken[6] = {0, 0, 0, 0, 0, 0};
+    for (int b : branch) ++taken[b];
+    std::printf("  %s: polar %d, rule %d, disc %d, derjaguin %d triangles; load %.4e N\n", at.c_str(),
+                taken[kBranchPolar], taken[kBranchRule], taken[kBranchDisc], taken[kBranchDerjaguin],
+                total_contact_load(space, mesh, contact));
+    for (int b = 0; b < 6; ++b) seen[b] += taken[b];
+    EXPECT_EQ(taken[kBranchMaugisDugdale], 0) << at;  // every rounded candidate got its state and branch
+    if (overlap < 0) {                                // nothing within h0: every row zero again
+      EXPECT_EQ(taken[kBranchNone], mesh.n_tris);
+      for (double l : to_host_vector(contact.tri_node_load)) ASSERT_EQ(l, 0.0);
+      for (double a : to_host_vector(contact.tri_friction_area)) ASSERT_EQ(a, 0.0);
+    }
+  }
+  for (int b : {kBranchPolar, kBranchRule, kBranchDisc, kBranchDerjaguin}) EXPECT_GT(seen[b], 0) << b;
+}
 }  // namespace
 }  // namespace dcm
