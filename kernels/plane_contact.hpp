@@ -98,17 +98,23 @@ template <class ExecutionSpace>
 using DynamicRange = Kokkos::RangePolicy<ExecutionSpace, Kokkos::Schedule<Kokkos::Dynamic>>;
 
 // The listed triangles (the first `count` of out.candidates) of one narrow-phase branch: f(t) returns the
-// triangle's TriangleContact.
+// triangle's TriangleContact. A functor, not a lambda: CUDA allows no extended lambda in a function
+// templated on a lambda's type.
+template <class MemorySpace, class F>
+struct NarrowPhase {
+  ContactBuffers<MemorySpace> out;
+  int branch;
+  F f;
+  KOKKOS_INLINE_FUNCTION void operator()(const int i) const {
+    const int t = out.candidates(i);
+    if (out.tri_branch(t) == branch) store(out, t, f(t));
+  }
+};
 template <class ExecutionSpace, class MemorySpace, class F>
 void narrow_phase(const char* label, const ExecutionSpace& space, const ContactBuffers<MemorySpace>& out,
                   int count, int branch, const F& f) {
-  const auto list = out.candidates;
-  const auto tri_branch = out.tri_branch;
-  Kokkos::parallel_for(
-      label, DynamicRange<ExecutionSpace>(space, 0, count, Kokkos::ChunkSize(8)), KOKKOS_LAMBDA(const int i) {
-        const int t = list(i);
-        if (tri_branch(t) == branch) store(out, t, f(t));
-      });
+  Kokkos::parallel_for(label, DynamicRange<ExecutionSpace>(space, 0, count, Kokkos::ChunkSize(8)),
+                       NarrowPhase<MemorySpace, F>{out, branch, f});
 }
 }  // namespace contact_detail
 
@@ -167,14 +173,15 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
           md(t, 5) = st.sigma0;
           tri_branch(t) = md_contact_branch(prm, st, tri_area(t));
         });
+  constexpr int lanes = ContactLanes<ExecutionSpace>::value;
   if (branches & branch_bit(kBranchPolar))
     contact_detail::narrow_phase(
         "dcm::contact::polar", space, out, count, kBranchPolar, KOKKOS_LAMBDA(const int t) {
           const PlaneContactParams prm = cell_value(params, tri_cell(t));
           const Real3 x0 = load3(x, tri(t, 0)), x1 = load3(x, tri(t, 1)), x2 = load3(x, tri(t, 2));
-          return polar_triangle_contact(prm, contact_detail::load_md(md, t), x0, x1, x2,
-                                        contact_centre(load3(center, t), p, n), n,
-                                        quadrature_area(prm, x0, x1, x2, n, tri_area(t)));
+          return polar_triangle_contact<lanes>(prm, contact_detail::load_md(md, t), x0, x1, x2,
+                                               contact_centre(load3(center, t), p, n), n,
+                                               quadrature_area(prm, x0, x1, x2, n, tri_area(t)));
         });
   if (branches & branch_bit(kBranchRule))
     contact_detail::narrow_phase(

@@ -177,8 +177,17 @@ KOKKOS_INLINE_FUNCTION void finish(const PlaneContactParams& prm, Real3 x0, Real
 }
 }  // namespace contact_detail
 
+// Gauss points per step of the polar integral (kernels/polar_contact_integral.hpp): 8 SIMD lanes where the
+// execution space runs on the host, 1 on a device (CUDA, HIP, SYCL), as MembraneLanes.
+template <class ExecutionSpace>
+struct ContactLanes {
+  static constexpr int value =
+      Kokkos::SpaceAccessibility<ExecutionSpace, Kokkos::HostSpace>::accessible ? 8 : 1;
+};
+
 // Exact in r, Gauss in θ (kernels/polar_contact_integral.hpp); eqs. 16–17 without regimes. C: the contact
-// centre (the foot of the sphere's centre on the plane).
+// centre (the foot of the sphere's centre on the plane). Lanes: ContactLanes.
+template <int Lanes = 8>
 KOKKOS_INLINE_FUNCTION TriangleContact polar_triangle_contact(const PlaneContactParams& prm,
                                                               const MdState& st, Real3 x0, Real3 x1, Real3 x2,
                                                               Real3 C, Real3 n, double area_q) {
@@ -187,7 +196,7 @@ KOKKOS_INLINE_FUNCTION TriangleContact polar_triangle_contact(const PlaneContact
   Real3 e1 = cross(ref, n);
   e1 = (1.0 / norm(e1)) * e1;
   const Real3 e2 = cross(n, e1);
-  const PolarIntegral pi = polar_contact_integral(st, x0, x1, x2, C, e1, e2);
+  const PolarIntegral pi = polar_contact_integral<Lanes>(st, x0, x1, x2, C, e1, e2);
   double lam[3] = {-1, 0, 0};
   const double fa = prm.friction_on_adhesive_zone ? pi.zone_area : pi.contact_area;
   if (fa > 1e-9 * area_q) {  // (a sliver's moments are rounding noise; its friction is negligible)

@@ -120,7 +120,9 @@ namespace detail {
 // from the foot F of the perpendicular from C: r(s) = F + s d̂, ρ² = h² + s², dθ = κ ds / ρ² with
 // κ = F × d̂ (= ±h). The integrands G(ρ) κ/ρ², H(ρ) κ/ρ³ (sin θ, cos θ) stay bounded and smooth even when C
 // lies on or near the edge's line (where an angle parametrisation is nearly singular); pieces split where
-// ρ = a and ρ = c, 8-point Gauss–Legendre on each.
+// ρ = a and ρ = c, 8-point Gauss–Legendre on each, Lanes points at a time (8 on the host: SIMD lanes; 1 on a
+// device, where 8 lanes of nine sums would take 144 registers; the sums run in the same order either way).
+template <int Lanes>
 KOKKOS_INLINE_FUNCTION void polar_sector(const MdRadial& st, double px, double py, double qx, double qy,
                                          PolarIntegral& out) {
   const double dx = qx - px, dy = qy - py, len = math::sqrt(dx * dx + dy * dy);
@@ -154,53 +156,60 @@ KOKKOS_INLINE_FUNCTION void polar_sector(const MdRadial& st, double px, double p
   for (int piece = 0; piece + 1 < n_cuts; ++piece) {
     const double s0 = cuts[piece], half = 0.5 * (cuts[piece + 1] - s0);
     if (half == 0) continue;
-    // 8-point Gauss–Legendre on [−1, 1] (local arrays: also valid in device code). The 8 points in lanes (no
-    // branches, so the host compiler vectorises them), then summed in order.
+    // 8-point Gauss–Legendre on [−1, 1] (local arrays: also valid in device code). Lanes points at a time (no
+    // branches, so the host compiler vectorises 8 of them), then summed in order.
     constexpr double gx[8] = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290,
                               -0.1834346424956498, 0.1834346424956498,  0.5255324099163290,
                               0.7966664774136267,  0.9602898564975363};
     constexpr double gw[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066458778873, 0.3626837833783620,
                               0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
-    double load[8], m1[8], m2[8], ca[8], za[8], cx[8], cy[8], zx[8], zy[8];
-    for (int i = 0; i < 8; ++i) {
-      const double sv = s0 + half * (gx[i] + 1);
-      const double rx = fx + sv * ux, ry = fy + sv * uy;
-      const double rho2 = h2 + sv * sv, rho = math::sqrt(rho2), inv_rho = 1.0 / rho;
-      const double dtheta = gw[i] * half * kappa * inv_rho * inv_rho;
-      double g, hr;
-      md_radial_integrals(st, rho, g, hr);
-      const double hm = hr * inv_rho;
-      load[i] = dtheta * g;
-      m1[i] = dtheta * hm * ry;  // ê × n = sin θ e1 − cos θ e2
-      m2[i] = dtheta * hm * rx;
-      const double ra = math::min(rho, st.a);
-      ca[i] = dtheta * 0.5 * ra * ra;
-      const double rz = math::min(rho, math::max(st.a, st.c));
-      za[i] = dtheta * 0.5 * rz * rz;
-      const double third = dtheta * inv_rho / 3.0;
-      const double ma = third * ra * ra * ra, mz = third * rz * rz * rz;
-      cx[i] = ma * rx;  // ∫ r ê(θ) r dr dθ, ê = (rx, ry)/ρ
-      cy[i] = ma * ry;
-      zx[i] = mz * rx;
-      zy[i] = mz * ry;
-    }
-    for (int i = 0; i < 8; ++i) {
-      out.load += load[i];
-      out.m1 += m1[i];
-      out.m2 -= m2[i];
-      out.contact_area += ca[i];
-      out.zone_area += za[i];
-      out.contact_x += cx[i];
-      out.contact_y += cy[i];
-      out.zone_x += zx[i];
-      out.zone_y += zy[i];
+    static_assert(Lanes == 1 || Lanes == 8, "1 or 8 lanes");
+    for (int i0 = 0; i0 < 8; i0 += Lanes) {
+      double load[Lanes], m1[Lanes], m2[Lanes], ca[Lanes], za[Lanes], cx[Lanes], cy[Lanes], zx[Lanes],
+          zy[Lanes];
+      for (int l = 0; l < Lanes; ++l) {
+        const int i = i0 + l;
+        const double sv = s0 + half * (gx[i] + 1);
+        const double rx = fx + sv * ux, ry = fy + sv * uy;
+        const double rho2 = h2 + sv * sv, rho = math::sqrt(rho2), inv_rho = 1.0 / rho;
+        const double dtheta = gw[i] * half * kappa * inv_rho * inv_rho;
+        double g, hr;
+        md_radial_integrals(st, rho, g, hr);
+        const double hm = hr * inv_rho;
+        load[l] = dtheta * g;
+        m1[l] = dtheta * hm * ry;  // ê × n = sin θ e1 − cos θ e2
+        m2[l] = dtheta * hm * rx;
+        const double ra = math::min(rho, st.a);
+        ca[l] = dtheta * 0.5 * ra * ra;
+        const double rz = math::min(rho, math::max(st.a, st.c));
+        za[l] = dtheta * 0.5 * rz * rz;
+        const double third = dtheta * inv_rho / 3.0;
+        const double ma = third * ra * ra * ra, mz = third * rz * rz * rz;
+        cx[l] = ma * rx;  // ∫ r ê(θ) r dr dθ, ê = (rx, ry)/ρ
+        cy[l] = ma * ry;
+        zx[l] = mz * rx;
+        zy[l] = mz * ry;
+      }
+      for (int l = 0; l < Lanes; ++l) {
+        out.load += load[l];
+        out.m1 += m1[l];
+        out.m2 -= m2[l];
+        out.contact_area += ca[l];
+        out.zone_area += za[l];
+        out.contact_x += cx[l];
+        out.contact_y += cy[l];
+        out.zone_x += zx[l];
+        out.zone_y += zy[l];
+      }
     }
   }
 }
 }  // namespace detail
 
 // ∫ over the triangle (x0, x1, x2) projected on the plane through C with unit normal n, of the radial MD
-// pressure about C; (e1, e2) an orthonormal basis of the plane with e1 × e2 = n.
+// pressure about C; (e1, e2) an orthonormal basis of the plane with e1 × e2 = n. Lanes: Gauss points per
+// step (detail::polar_sector; ContactLanes picks it per execution space).
+template <int Lanes = 8>
 KOKKOS_INLINE_FUNCTION PolarIntegral polar_contact_integral(const MdState& st, Real3 x0, Real3 x1, Real3 x2,
                                                             Real3 C, Real3 e1, Real3 e2) {
   const Real3 xs[3] = {x0, x1, x2};
@@ -211,7 +220,8 @@ KOKKOS_INLINE_FUNCTION PolarIntegral polar_contact_integral(const MdState& st, R
   }
   PolarIntegral out;
   const MdRadial m = md_radial(st);
-  for (int k = 0; k < 3; ++k) detail::polar_sector(m, qx[k], qy[k], qx[(k + 1) % 3], qy[(k + 1) % 3], out);
+  for (int k = 0; k < 3; ++k)
+    detail::polar_sector<Lanes>(m, qx[k], qy[k], qx[(k + 1) % 3], qy[(k + 1) % 3], out);
   const double orientation = (qx[1] - qx[0]) * (qy[2] - qy[0]) - (qy[1] - qy[0]) * (qx[2] - qx[0]);
   if (orientation < 0) {
     out.load = -out.load;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/host_copy.hpp"
@@ -290,7 +291,8 @@ void reference_integral(const MdState& st, Real3 p0, Real3 p1, Real3 p2, int lev
 }
 
 // The exact polar integration of one triangle against a fine subdivision: force and moment, for triangles
-// inside the contact, across r = a, across r = c, containing C, and far from C (λ = 1 and 10).
+// inside the contact, across r = a, across r = c, containing C, and far from C (λ = 1 and 10); and the
+// device's form (one Gauss point at a time) against the host's (8 lanes).
 TEST(PlaneContact, PolarIntegralOfOneTriangleMatchesAFineReference) {
   const Real3 e1{1, 0, 0}, e2{0, 1, 0}, C{0, 0, 0};
   for (double lambda : {1.0, 10.0}) {
@@ -313,6 +315,14 @@ TEST(PlaneContact, PolarIntegralOfOneTriangleMatchesAFineReference) {
       EXPECT_NEAR(pi.load, F, tol * scale) << "lambda " << lambda;
       EXPECT_NEAR(pi.m1, M.x, tol * scale * 1e-6) << "lambda " << lambda;
       EXPECT_NEAR(pi.m2, M.y, tol * scale * 1e-6) << "lambda " << lambda;
+      // One Gauss point at a time (a device's form) sums the same terms in the same order as 8 lanes.
+      const PolarIntegral one = polar_contact_integral<1>(st, t[0], t[1], t[2], C, e1, e2);
+      for (const auto& [lanes, single] :
+           {std::pair{pi.load, one.load}, std::pair{pi.m1, one.m1}, std::pair{pi.m2, one.m2},
+            std::pair{pi.zone_area, one.zone_area}, std::pair{pi.contact_x, one.contact_x},
+            std::pair{pi.zone_y, one.zone_y}})
+        EXPECT_NEAR(single, lanes, 1e-13 * std::fabs(lanes)) << "lambda " << lambda;
+      EXPECT_GT(std::fabs(one.load), 0.0);
     }
   }
 }
