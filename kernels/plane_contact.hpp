@@ -79,6 +79,16 @@ KOKKOS_INLINE_FUNCTION void store(const ContactBuffers<MemorySpace>& out, int t,
     }
 }
 
+// A triangle's MdState in ContactBuffers::tri_md (a, c, δ, P, p0, σ0) and back.
+template <class View>
+KOKKOS_INLINE_FUNCTION void store_md(const View& md, int t, const MdState& st) {
+  md(t, 0) = st.a;
+  md(t, 1) = st.c;
+  md(t, 2) = st.delta;
+  md(t, 3) = st.P;
+  md(t, 4) = st.p0;
+  md(t, 5) = st.sigma0;
+}
 template <class View>
 KOKKOS_INLINE_FUNCTION MdState load_md(const View& md, int t) {
   MdState st;
@@ -156,7 +166,7 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
       },
       count);
   if (count == 0) return;
-  if (branches & (branch_bit(kBranchPolar) | branch_bit(kBranchRule) | branch_bit(kBranchDisc)))
+  if (branches & kMaugisDugdaleBranches)
     Kokkos::parallel_for(
         "dcm::contact::md_state",
         contact_detail::DynamicRange<ExecutionSpace>(space, 0, count, Kokkos::ChunkSize(8)),
@@ -165,12 +175,7 @@ void compute_plane_contact(const ExecutionSpace& space, const MeshBuffers<Memory
           if (tri_branch(t) != kBranchMaugisDugdale) return;
           const PlaneContactParams prm = cell_value(params, tri_cell(t));
           const MdState st = md_contact_state(prm, load3(center, t), radius(t), p, n);
-          md(t, 0) = st.a;
-          md(t, 1) = st.c;
-          md(t, 2) = st.delta;
-          md(t, 3) = st.P;
-          md(t, 4) = st.p0;
-          md(t, 5) = st.sigma0;
+          contact_detail::store_md(md, t, st);
           tri_branch(t) = md_contact_branch(prm, st, tri_area(t));
         });
   constexpr int lanes = ContactLanes<ExecutionSpace>::value;

@@ -54,8 +54,9 @@ enum ContactBranch : int {
 };
 // Bit masks of branches (which narrow-phase kernels a set of parameters can need).
 constexpr int branch_bit(int branch) { return 1 << branch; }
-constexpr int kAllContactBranches = branch_bit(kBranchPolar) | branch_bit(kBranchRule) |
-                                    branch_bit(kBranchDisc) | branch_bit(kBranchDerjaguin);
+// The branches that need a Maugis–Dugdale state (the md_state kernel).
+constexpr int kMaugisDugdaleBranches =
+    branch_bit(kBranchPolar) | branch_bit(kBranchRule) | branch_bit(kBranchDisc);
 inline int plane_contact_branches(const PlaneContactParams& p) {
   if (p.derjaguin) return branch_bit(kBranchDerjaguin);
   if (p.quadrature_points == 0) return branch_bit(kBranchPolar);
