@@ -352,6 +352,15 @@ class CortexModel {
                            " (term: " + term_with_non_finite_force(bad_node) + ")");
   }
 
+  // The contact of the current positions (the geometry and the contact stage of compute_forces(), no forces):
+  // what contact_area(), contact_load() and contact() report after a step has moved the nodes. The contact
+  // kernels keep no state between calls, so the next compute_forces() at these positions computes the same.
+  void update_contact() {
+    if (!contact_) return;
+    update_geometry(space_, mesh_, geo_, params_.h_min, rounded_geometry_);
+    compute_plane_contact(space_, mesh_, geo_, params_.plane, contact_params_, *contact_);
+  }
+
   // Total energy for the current positions (calls update_geometry()).
   // per_cell (optional): each cell's energy, the same terms added in the same order (a batch's cell gets
   // the bits it gets alone).

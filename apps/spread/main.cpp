@@ -4,7 +4,8 @@
 // the cortex terms and dashpots of the scene. Writes to <out>/:
 //   series.csv   t_s,r_cc_m,contact_area_m2,area_m2,volume_m3,cg_iterations,dt_s,height_m,contact_load_N,
 //                elastic_energy_J,dE_dt_W,contact_power_W,dissipation_W,energy_residual_W
-//                (log-spaced in time: output.series_per_decade rows per decade, and every step at the start)
+//                (log-spaced in time: output.series_per_decade rows per decade, every step at the start, and
+//                the last step; each row the state at its t_s)
 //   spread.h5/.xmf  mesh, series (every column of series.csv), frames (every output.frame_every_s and at
 //                t = 0.1, 0.35, 0.9 s) with the per-node normal force and pressure, cortex tension (eq. 1)
 //                and stretch; not with output.hdf5 = false

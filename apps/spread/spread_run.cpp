@@ -164,7 +164,10 @@ struct BeforeStep {
         while (f < kFigureTimes.size() && kFigureTimes[f] <= t + 1e-12) ++f;
         p.next_figure = static_cast<double>(f);
       }
-      m.sample = t >= p.next_sample || m.index < 10 || h_planned[m.cell] >= m.h_cap;
+      // The run's last step always writes a row (the same test as account_step's m.last: a fixed-step run
+      // whose steps add up to t_end within rounding ends on a step shorter than its cap).
+      const bool ends_run = t + h_planned[m.cell] >= m.t_end * (1 - 1e-12);
+      m.sample = t >= p.next_sample || m.index < 10 || h_planned[m.cell] >= m.h_cap || ends_run;
       any_sample = any_sample || m.sample;
     }
     if (any_sample) {  // each cell's own sums (solvers/cortex_model.hpp): the bits of its run alone
@@ -191,6 +194,7 @@ struct AfterStep {
     for (const Member& m : ms) any_row = any_row || (!m.done && cap[m.cell] > 0 && m.sample);
     if (!any_row) return;
     model.energy(&energy);
+    model.update_contact();  // the row's r_cc, contact area and load at t + h, as its other columns
     model.contact_area(&contact_area);
     model.contact_load(&contact_load);
     cell_area = to_host_vector(model.geometry().cell_area);

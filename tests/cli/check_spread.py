@@ -46,6 +46,11 @@ def main():
     for k in KEYS:
         if k not in s:
             fail(f"summary.json has no key {k}")
+    # The run's last step writes a row: the series ends at t_end, and r_cc_final_m is its r_cc.
+    if not interrupted and not math.isclose(float(rows[-1]["t_s"]), s["t_end_s"], rel_tol=1e-6):
+        fail(f"series.csv ends at t = {rows[-1]['t_s']} s, the run at t_end_s = {s['t_end_s']} s")
+    if not interrupted and not math.isclose(float(rows[-1]["r_cc_m"]), s["r_cc_final_m"], rel_tol=1e-6):
+        fail(f"summary.json r_cc_final_m = {s['r_cc_final_m']}, the last row {rows[-1]['r_cc_m']}")
     if s.get("interrupted") != interrupted:
         fail(f"summary.json interrupted = {s.get('interrupted')}, expected {interrupted}")
     if not interrupted and not s["energy_residual_relative"] < 0.05:
