@@ -13,7 +13,9 @@ not the claims hold (the table says), 2 if DIR does not exist.
 
 The thresholds a row applies are printed in its "target" column; where the paper gives a band (0.5 ± 0.1,
 65° ± 10°) that band is used, where it gives a direction ("faster", "wider") a change of 0.5% or more that
-way (smaller changes are within the scatter of adaptive 642-node runs, docs/PERFORMANCE.md).
+way (the Figure 5 runs are adaptive 2562-node runs since session 27, whose r_cc moves by less than 0.01%
+when the CG tolerance changes by 1%; 642-node runs scatter by several per cent in the touch-down,
+docs/PERFORMANCE.md).
 """
 import csv
 import json
