@@ -37,22 +37,21 @@ struct RelaxOptions {
   bool no_plot = false;
 };
 
-// Least-squares slope of log(y) against t over the samples with y > floor; returns −1/slope.
+// Hochmuth's form with its prefactor y0 = y(0) fixed, as the header writes it: the least-squares slope of
+// log(y / y0) against t through the origin, over the samples from the start while y > floor; returns
+// −1/slope (NaN with fewer than 3 samples). (Sessions 1–26 fitted a free intercept: 1% longer t_c.)
 double fit_relaxation_time(const std::vector<double>& t, const std::vector<double>& y, double floor) {
-  double st = 0, sy = 0, stt = 0, sty = 0;
+  if (y.empty() || !(y[0] > 0)) return NAN;
+  double stt = 0, sty = 0;
   int n = 0;
   for (std::size_t i = 0; i < t.size(); ++i) {
     if (!(y[i] > floor)) break;
-    const double ly = std::log(y[i]);
-    st += t[i];
-    sy += ly;
     stt += t[i] * t[i];
-    sty += t[i] * ly;
+    sty += t[i] * std::log(y[i] / y[0]);
     ++n;
   }
-  if (n < 3) return NAN;
-  const double slope = (n * sty - st * sy) / (n * stt - st * st);
-  return -1.0 / slope;
+  if (n < 3 || !(stt > 0)) return NAN;
+  return -stt / sty;
 }
 
 void run(const AppOptions& options, const RelaxOptions& ro) {
@@ -131,7 +130,8 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
     }
     cg_total += r.iterations;
     cg_max = std::max(cg_max, r.iterations);
-    if (step % ro.sample_every == 0) {
+    const bool last = step == steps;  // the end state always gets a row and a frame
+    if (step % ro.sample_every == 0 || last) {
       const auto x = to_host_vector(model.positions());
       const auto [da, dtr] = axial_transverse_diameters(x);
       const double dissipation = model.dissipation();
@@ -142,7 +142,7 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
       csv << line;
       ts.push_back(t);
       ys.push_back((da / dtr - lambda_inf) / (da / dtr + lambda_inf));
-      if (step % (ro.sample_every * 20) == 0) {
+      if (step % (ro.sample_every * 20) == 0 || last) {
         if (h5) h5->write_frame(t, x.data(), {});
         if (!options.quiet)
           std::printf("  t = %.4f s  D_A = %.3f um  D_T = %.3f um  CG %d it  (%.0f%%)\n", t, da * 1e6,
@@ -150,7 +150,7 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
         std::fflush(stdout);  // progress must show when the output goes to a file
       }
     }
-    model.advance(dt);
+    if (!last) model.advance(dt);
   }
   csv.close();
   std::rename((out + "/series.csv.tmp").c_str(), (out + "/series.csv").c_str());
@@ -166,6 +166,7 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
       .add("lambda_inf", lambda_inf)
       .add("relaxation_time_s", tc)
       .add("dt_s", dt)
+      .add("t_end_s", steps * dt)
       .add("steps", steps)
       .add("mean_cg_iterations", static_cast<double>(cg_total) / (steps + 1))
       .add("max_cg_iterations", cg_max)

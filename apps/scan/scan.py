@@ -226,6 +226,16 @@ def member_state(mdir, member):
     return "resume" if os.path.isfile(os.path.join(mdir, "checkpoint.h5")) else "new"
 
 
+def results_of(mdir, member):
+    """True when mdir's files are this member's: its member.json holds the same sets. A folder left by an
+    earlier scan file with other values (the member not launched in this run) is not reported."""
+    try:
+        with open(os.path.join(mdir, "member.json")) as f:
+            return json.load(f)["sets"] == member["sets"]
+    except (OSError, ValueError, KeyError):
+        return False
+
+
 def collect(scan, out, spread_ok):
     rows = []
     for m in scan["members"]:
@@ -233,6 +243,8 @@ def collect(scan, out, spread_ok):
         row = {"id": m["id"], "status": spread_ok.get(m["id"], "not run")}
         row.update({k: m["swept"].get(k, "") for k in scan["sweep_keys"]})
         try:
+            if not results_of(mdir, m):
+                raise OSError("another member's results")
             with open(os.path.join(mdir, "summary.json")) as f:
                 s = json.load(f)
             row.update({k: ("" if s.get(k) is None else s[k]) for k in SUMMARY_KEYS})  # null: not measured
@@ -271,7 +283,7 @@ def write_h5(scan, out, rows):
                 if row.get(k, "") != "":
                     mg.attrs[k] = row[k]
             src_path = os.path.join(out, "members", m["id"], "spread.h5")
-            if not os.path.isfile(src_path):
+            if not os.path.isfile(src_path) or not results_of(os.path.dirname(src_path), m):
                 continue
             with h5py.File(src_path, "r") as src:
                 if "series" in src:
