@@ -151,6 +151,8 @@ NewtonResult newton_equilibrium(CortexModel<ExecutionSpace>& model, const Newton
                    result.newton_steps, result.max_force, energy, mu, it,
                    trial < INFINITY ? "" : " (overstretched: retry)");
   }
+  // The step that used up max_newton_steps may have reached the tolerance: the loop's test did not see it.
+  if (result.max_force <= s.force_tol) result.converged = true;
   return result;
 }
 
