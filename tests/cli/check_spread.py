@@ -10,6 +10,7 @@ import json
 import math
 import os
 import sys
+import tomllib
 
 os.environ.setdefault("HDF5_USE_FILE_LOCKING", "FALSE")
 import h5py  # noqa: E402
@@ -58,6 +59,13 @@ def main():
     if s.get("warnings") != []:
         fail(f"summary.json warnings = {s.get('warnings')}, expected none")
     with h5py.File(os.path.join(out, "spread.h5"), "r") as h5:
+        # A run that reached its end reports the scene's t_end itself, not the rounded sum of its steps.
+        text = h5.attrs["scene"]
+        scene = tomllib.loads(text.decode() if isinstance(text, bytes) else text)
+        t_end = float(scene["time"]["t_end_s"])
+        if not interrupted and not s.get("stopped_at_max_steps") and not s.get("restarted_from") \
+                and s["t_end_s"] != t_end:
+            fail(f"summary.json t_end_s = {s['t_end_s']!r}, the scene's time.t_end_s = {t_end!r}")
         frames = list(h5["frames"].keys())
         if not frames:
             fail("no frames in spread.h5")
