@@ -55,6 +55,7 @@ struct StepReport {
   int rejections = 0;  // adaptive: times the previous step was taken again, shorter
   int unconverged_solves = 0;  // solves that reached the CG iteration cap (each retried with h/2)
   double error_m = 0;          // adaptive: the error estimate of the previous step (m)
+  double redone_h = 0;         // adaptive, with rejections: the new length of the previous step (s)
 };
 
 namespace stepper_detail {
@@ -223,6 +224,8 @@ class TimeStepper {
           if (rejected[c]) h_solved[c] = h_prev_[c];
         solve(model, cg, rejected, h_solved, rep);
       }
+      for (int c = 0; c < n_; ++c)
+        if (rep[c].rejections > 0) rep[c].redone_h = h_prev_[c];
       if (settings_.contact_change > 0) {  // A_c at the start of this step, for the next step's check
         if (!areas_current) areas = cell_contact_areas(model);
         for (int c = 0; c < n_; ++c)

@@ -109,6 +109,11 @@ struct Member {
   std::vector<double> ts, rs, areas_c, heights;  // series columns the summary's fits use
   std::vector<double> series_rows;               // every series row (kSeriesColumns values each), for HDF5
   std::string csv_text = series_header();
+  // The row of the last sampled step (kSeriesColumns values, then the step's start energy), written once the
+  // next step has accepted that step: an adaptive step may take the one before it again, shorter
+  // (solvers/time_stepper.hpp), and the row then describes the state that step reaches instead.
+  std::vector<double> pending_row;
+  double h_last = 0;  // the last step's length, into dt_min/max_taken_s once the next step accepts it
   int frames_before = 0;
   std::ofstream csv;
   std::unique_ptr<H5Output> h5;   // spread.h5; null with output.hdf5 = false
@@ -141,6 +146,8 @@ FrameData frame_data(Model& model, NodeFields<Exec::memory_space>& fields);
 
 // One series row into spread.h5's /series (nothing with output.hdf5 = false).
 void append_h5_series(Member& m, const double* row);
+// The member's pending row (if any) into series.csv.part, spread.h5 and the fits' columns.
+void commit_row(Member& m);
 // The member's slice of a frame into spread.h5 at time t (nothing with output.hdf5 = false).
 void write_frame(Member& m, const FrameData& d, double t);
 // A checkpoint at a step boundary: the member's cell, its stepper state, and what it has written

@@ -17,6 +17,28 @@ void append_h5_series(Member& m, const double* row) {
   m.h5->append_series(named);
 }
 
+void commit_row(Member& m) {
+  if (m.pending_row.empty()) return;
+  const std::vector<double>& row = m.pending_row;
+  Progress& p = m.p;
+  p.worst_residual = std::max(p.worst_residual, std::fabs(row[13]));
+  p.worst_residual_scale = std::max(p.worst_residual_scale, std::fabs(row[12]) + std::fabs(row[11]));
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "%.9g,%.9g,%.9g,%.9g,%.9g,%d,%.6g,%.9g,%.9g,%.12g,%.12g,%.12g,%.12g,%.12g\n", row[0], row[1],
+                row[2], row[3], row[4], static_cast<int>(row[5]), row[6], row[7], row[8], row[9], row[10],
+                row[11], row[12], row[13]);
+  m.csv << line;
+  m.csv_text += line;
+  m.ts.push_back(row[0]);
+  m.rs.push_back(row[1]);
+  m.areas_c.push_back(row[2]);
+  m.heights.push_back(row[7]);
+  m.series_rows.insert(m.series_rows.end(), row.begin(), row.begin() + kSeriesColumns.size());
+  append_h5_series(m, row.data());
+  m.pending_row.clear();
+}
+
 void write_frame(Member& m, const FrameData& d, double t) {
   if (!m.h5) return;
   const auto slice = [&](const std::vector<double>& all, int per_node) {
@@ -47,6 +69,8 @@ void write_checkpoint_now(Member& m, const Model& model, const Stepper& stepper,
   c.put("app.height_m", m.heights);
   c.put_text("app.series_csv", m.csv_text);
   c.put("app.series_rows", m.series_rows);
+  c.put("app.pending_row", m.pending_row);
+  c.put("app.h_last", m.h_last);
   c.put("app.frames", m.h5 ? static_cast<double>(m.h5->frames()) : 0.0);
   if (m.h5) m.h5->flush();
   write_checkpoint(m.checkpoint_path, c);
@@ -56,6 +80,7 @@ void write_checkpoint_now(Member& m, const Model& model, const Stepper& stepper,
 [[noreturn]] void stop_on_numerical_trouble(std::vector<Member>& ms, const std::string& what) {
   for (Member& m : ms) {
     if (m.done) continue;
+    commit_row(m);
     if (m.h5) m.h5->close();
     m.csv.close();
     std::rename(m.csv_tmp.c_str(), (m.out_dir + "/series.csv").c_str());
@@ -68,8 +93,20 @@ void write_checkpoint_now(Member& m, const Model& model, const Stepper& stepper,
 
 void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<Exec::memory_space>& fields,
                    double wall_now) {
-  write_checkpoint_now(m, model, stepper, wall_now);
+  write_checkpoint_now(m, model, stepper,
+                       wall_now);  // with the last row pending: a continuation may redo its step
+  commit_row(m);
+  if (m.h_last > 0) {
+    m.p.h_min = std::min(m.p.h_min, m.h_last);
+    m.p.h_max = std::max(m.p.h_max, m.h_last);
+  }
   model.compute_forces();
+  // r_cc of the end state (the last row's, when the last step wrote one; not an older row's when a run stops
+  // early)
+  model.update_contact();
+  std::vector<double> area_c;
+  model.contact_area(&area_c);
+  const double r_final = std::sqrt(area_c[m.cell] / kPi);
   // A run that reached t_end reports t_end: its steps' sum differs from it by rounding only (a fixed-step run
   // of 5000 steps of 6 µs sums to 0.02999999999999871 s).
   const double t_sum = stepper.time(m.cell);
@@ -129,7 +166,7 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
       .add("adaptive", stepper.settings().adaptive)
       .add("dt_min_taken_s", std::isfinite(p.h_min) ? p.h_min : 0.0)
       .add("dt_max_taken_s", p.h_max)
-      .add("r_cc_final_m", m.rs.empty() ? 0.0 : m.rs.back())
+      .add("r_cc_final_m", r_final)
       .add("contact_angle_deg", cap.angle_deg)
       .add("cap_radius_m", cap.radius)
       .add("contact_angle_free_deg", cap_free.angle_deg)
@@ -159,9 +196,8 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
         "  %sr_cc = %.3f um, contact angle %.1f deg (free membrane %.1f), early exponent %s (t in [%g, %g] "
         "s), height %.3f um; "
         "%lld steps in %.1f s, mean CG %.1f\n",
-        m.cell > 0 || !m.so.batch.empty() ? (m.out_dir + ": ").c_str() : "",
-        (m.rs.empty() ? 0.0 : m.rs.back()) * 1e6, cap.angle_deg, cap_free.angle_deg, exponent,
-        so.early_from_s, so.early_to_s, (ztop - m.plane_z) * 1e6, done, wall,
+        m.cell > 0 || !m.so.batch.empty() ? (m.out_dir + ": ").c_str() : "", r_final * 1e6, cap.angle_deg,
+        cap_free.angle_deg, exponent, so.early_from_s, so.early_to_s, (ztop - m.plane_z) * 1e6, done, wall,
         done > 0 ? p.cg_total / done : 0.0);
   }
   // Adaptive steps control the position error, not the energy bookkeeping: say when the longest steps left

@@ -70,6 +70,8 @@ void restore_from_checkpoint(Member& m, Model& model, Stepper& stepper) {
       m.series_rows[i * w + 7] = m.heights[i];
     }
   }
+  if (c.arrays.count("app.pending_row")) m.pending_row = c.array("app.pending_row");  // since session 28
+  if (c.arrays.count("app.h_last")) m.h_last = c.scalar("app.h_last");
   m.frames_before = static_cast<int>(c.scalar("app.frames"));
 }
 
@@ -137,21 +139,98 @@ bool plan_step(std::vector<Member>& ms, const Stepper& stepper, std::vector<doub
   return any_running;
 }
 
-// Before the step, on the state at t (the stepper calls it once the steps are planned): the frames due now,
-// which members write a series row after this step, and their energy and powers at t.
+// After the step, the state at t + h that the sampled members' rows need (read once for all of them).
+struct AfterStep {
+  std::vector<double> energy, contact_area, contact_load, cell_area, cell_volume, x;
+  bool any_row = false;
+
+  void read(const std::vector<Member>& ms, const std::vector<double>& cap, Model& model) {
+    any_row = false;
+    for (const Member& m : ms) any_row = any_row || (!m.done && cap[m.cell] > 0 && m.sample);
+    if (any_row) read_all(model);
+  }
+  // The state of every cell now, whether a member samples it or not.
+  void read_all(Model& model) {
+    model.energy(&energy);
+    model.update_contact();  // the row's r_cc, contact area and load at t + h, as its other columns
+    model.contact_area(&contact_area);
+    model.contact_load(&contact_load);
+    cell_area = to_host_vector(model.geometry().cell_area);
+    cell_volume = to_host_vector(model.geometry().cell_volume);
+    x = to_host_vector(model.positions());
+  }
+};
+
+// A series row of member m for its step from t, h long, ending in the state `after` holds, with the step's
+// energy balance: (E(t+h) − E(t))/h against the contact power minus the dissipation, both at the step's
+// start with its velocity. Then the step's start energy (the row's 15th value, for a redo).
+std::vector<double> make_row(const Member& m, double t, double h, int iterations, double e0, double pc,
+                             double dis, const AfterStep& after) {
+  const double e_after = after.energy[m.cell], de = (e_after - e0) / h;
+  const double area_c = after.contact_area[m.cell];
+  double ztop = -INFINITY;
+  for (int i = m.first_node; i < m.first_node + m.n; ++i) ztop = std::max(ztop, after.x[3 * i + 2]);
+  std::vector<double> row = {t + h,
+                             std::sqrt(area_c / kPi),
+                             area_c,
+                             after.cell_area[m.cell],
+                             after.cell_volume[m.cell],
+                             static_cast<double>(iterations),
+                             h,
+                             ztop - m.plane_z,
+                             after.contact_load[m.cell],
+                             e_after,
+                             de,
+                             pc,
+                             dis,
+                             de - (pc - dis),
+                             e0};
+  return row;
+}
+
+// Before the step, on the state at t (the stepper calls it once the steps are planned and the step before
+// is accepted): the last step's pending row, the frames due now, which members write a series row after this
+// step, and their energy and powers at t.
 struct BeforeStep {
   std::vector<Member>& ms;
   const std::vector<double>& cap;
   Model& model;
+  const Stepper& stepper;
   NodeFields<Exec::memory_space>& fields;
   std::vector<double> e0, pc, dis;
 
+  // The pending rows, now that their steps are accepted. A step the stepper has just taken again, shorter
+  // (the time moved back), gets the row of the state it reaches instead: its start state, velocity and
+  // powers are the same.
+  void commit_pending_rows() {
+    std::optional<AfterStep> now;  // read once, for every member whose last step was taken again
+    for (Member& m : ms) {
+      if (m.done || m.pending_row.empty()) continue;
+      const double t_now = stepper.time(m.cell);
+      if (t_now != m.pending_row[0]) {
+        if (!now) {
+          now.emplace();
+          now->read_all(model);
+        }
+        const std::vector<double>& old = m.pending_row;
+        const double t0 = old[0] - old[6];
+        std::vector<double> row =
+            make_row(m, t0, t_now - t0, static_cast<int>(old[5]), old[14], old[11], old[12], *now);
+        row[0] = t_now;
+        m.pending_row = row;
+      }
+      commit_row(m);
+    }
+  }
+
   void operator()(const std::vector<double>& h_planned) {
+    commit_pending_rows();
     bool any_sample = false;
     std::optional<FrameData> frame;  // computed once, for every member that writes a frame now
     for (Member& m : ms) {
       m.sample = false;
       if (m.done || cap[m.cell] == 0) continue;
+      m.t = stepper.time(m.cell);  // not plan_step's: a rejection of the step before moves the time back
       const double t = m.t;
       Progress& p = m.p;
       const auto next_figure = static_cast<std::size_t>(p.next_figure);
@@ -184,34 +263,10 @@ struct BeforeStep {
   }
 };
 
-// After the step, the state at t + h that the sampled members' rows need (read once for all of them).
-struct AfterStep {
-  std::vector<double> energy, contact_area, contact_load, cell_area, cell_volume, x;
-  bool any_row = false;
-
-  void read(const std::vector<Member>& ms, const std::vector<double>& cap, Model& model) {
-    any_row = false;
-    for (const Member& m : ms) any_row = any_row || (!m.done && cap[m.cell] > 0 && m.sample);
-    if (!any_row) return;
-    model.energy(&energy);
-    model.update_contact();  // the row's r_cc, contact area and load at t + h, as its other columns
-    model.contact_area(&contact_area);
-    model.contact_load(&contact_load);
-    cell_area = to_host_vector(model.geometry().cell_area);
-    cell_volume = to_host_vector(model.geometry().cell_volume);
-    x = to_host_vector(model.positions());
-  }
-};
-
-// One series row of a sampled member after its step r (to series.csv.part, spread.h5 and the fits' columns),
-// with the step's energy balance: (E(t+h) − E(t))/h against the contact power minus the dissipation.
+// The row of a sampled member after its step r, pending until the next step accepts the step.
 void record_row(std::vector<Member>& ms, Member& m, const StepReport& r, const AfterStep& after,
                 const Model& model) {
-  Progress& p = m.p;
   const double h = r.h, t = m.t;
-  const double e_after = after.energy[m.cell], de = (e_after - m.e0) / h, residual = de - (m.pc - m.dis);
-  p.worst_residual = std::max(p.worst_residual, std::fabs(residual));
-  p.worst_residual_scale = std::max(p.worst_residual_scale, std::fabs(m.dis) + std::fabs(m.pc));
   const double area_c = after.contact_area[m.cell];
   if (!(area_c >= 0)) {  // not finite: the state is no longer a cell
     const auto tri_area_c = to_host_vector(model.contact()->tri_contact_area);
@@ -224,37 +279,10 @@ void record_row(std::vector<Member>& ms, Member& m, const StepReport& r, const A
                                       " m² (first at triangle " + std::to_string(bad - t0) + ")" +
                                       (ms.size() > 1 ? " of member " + m.out_dir : std::string()));
   }
-  const double r_cc = std::sqrt(area_c / kPi);
-  double ztop = -INFINITY;
-  for (int i = m.first_node; i < m.first_node + m.n; ++i) ztop = std::max(ztop, after.x[3 * i + 2]);
-  const double row[] = {t + h,
-                        r_cc,
-                        area_c,
-                        after.cell_area[m.cell],
-                        after.cell_volume[m.cell],
-                        static_cast<double>(r.iterations),
-                        h,
-                        ztop - m.plane_z,
-                        after.contact_load[m.cell],
-                        e_after,
-                        de,
-                        m.pc,
-                        m.dis,
-                        residual};
-  static_assert(sizeof row / sizeof row[0] == 14, "one value per series column");
-  char line[512];
-  std::snprintf(line, sizeof line, "%.9g,%.9g,%.9g,%.9g,%.9g,%d,%.6g,%.9g,%.9g,%.12g,%.6g,%.6g,%.6g,%.6g\n",
-                row[0], row[1], row[2], row[3], row[4], r.iterations, row[6], row[7], row[8], row[9], row[10],
-                row[11], row[12], row[13]);
-  m.csv << line;
-  m.csv_text += line;
-  m.ts.push_back(t + h);
-  m.rs.push_back(r_cc);
-  m.areas_c.push_back(area_c);
-  m.heights.push_back(ztop - m.plane_z);
-  m.series_rows.insert(m.series_rows.end(), row, row + kSeriesColumns.size());
-  append_h5_series(m, row);
-  p.next_sample = (t + h) * std::pow(10.0, 1.0 / m.per_decade);
+  m.pending_row = make_row(m, t, h, r.iterations, m.e0, m.pc, m.dis, after);
+  // The run's end: the time it was asked to reach, not the rounded sum of its steps.
+  if (m.last && std::fabs(t + h - m.t_end) <= 1e-12 * m.t_end) m.pending_row[0] = m.t_end;
+  m.p.next_sample = (t + h) * std::pow(10.0, 1.0 / m.per_decade);
 }
 
 // The step's counts into the member's progress, and its row if it was sampled.
@@ -267,8 +295,12 @@ void account_step(std::vector<Member>& ms, Member& m, const StepReport& r, const
   p.cg_max = std::max(p.cg_max, static_cast<double>(r.iterations));
   p.halved += r.halvings;
   p.rejected += r.rejections;
-  p.h_min = std::min(p.h_min, r.h);
-  p.h_max = std::max(p.h_max, r.h);
+  if (r.redone_h > 0) m.h_last = r.redone_h;  // this step took the one before it again, shorter
+  if (m.h_last > 0) {
+    p.h_min = std::min(p.h_min, m.h_last);
+    p.h_max = std::max(p.h_max, m.h_last);
+  }
+  m.h_last = r.h;
   if (m.sample) record_row(ms, m, r, after, model);
   m.stopped_at_max_steps = m.so.max_steps > 0 && p.step >= static_cast<double>(m.so.max_steps) && !m.last;
 }
@@ -372,7 +404,7 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
     if (!plan_step(ms, stepper, cap)) break;
     std::vector<StepReport> rep;
     try {
-      rep = stepper.step(model, ms.front().cg, cap, BeforeStep{ms, cap, model, fields, {}, {}, {}});
+      rep = stepper.step(model, ms.front().cg, cap, BeforeStep{ms, cap, model, stepper, fields, {}, {}, {}});
     } catch (const NumericalError& e) {
       const Member& m = ms.front();
       stop_on_numerical_trouble(ms, (ms.size() == 1 ? "step " + std::to_string(m.index) + " (t = " +

@@ -41,6 +41,12 @@ def main():
         for k, v in r.items():
             if not math.isfinite(float(v)):
                 fail(f"non-finite {k} = {v} at t = {r['t_s']}")
+    # Each row is a state the run kept: time moves forward, and a row's step starts no earlier than the row
+    # before it ends (an adaptive step that takes the step before again, shorter, replaces that step's row).
+    for a, b in zip(rows, rows[1:]):
+        ta, tb, hb = float(a["t_s"]), float(b["t_s"]), float(b["dt_s"])
+        if not tb > ta or tb - hb < ta - 1e-5 * hb:  # dt_s has 6 digits
+            fail(f"row at t = {tb} s (dt_s = {hb}) after the row at t = {ta} s")
     if not interrupted and not float(rows[-1]["r_cc_m"]) > float(rows[1]["r_cc_m"]):
         fail("r_cc did not grow")
     s = json.load(open(os.path.join(out, "summary.json")))
