@@ -157,7 +157,7 @@ std::vector<ParamSpec> make_schema() {
           "off)"),
 
       real_key("time.dt_s", "6e-6", 0, 1, kExcl, "s", "time step (with time.adaptive: the first step)"),
-      real_key("time.t_end_s", "1.2", 0, 1e6, kIncl, "s", "simulated time"),
+      real_key("time.t_end_s", "1.2", 0, 1e6, kExcl, "s", "simulated time"),
       bool_key("time.adaptive", "false",
                "error-controlled time steps (Euler against Heun, docs/model/time_stepping.md); false: the "
                "fixed time.dt_s of the paper"),
@@ -173,8 +173,10 @@ std::vector<ParamSpec> make_schema() {
                "CG stops when the force residual ||F − Γv||₂ is below this (the paper's 1e-14 N) ..."),
       real_key("solver.cg_rel_tol", "0", 0, 0.1, kIncl, "",
                "... or below this fraction of ||F||₂ (the looser of the two wins)"),
-      int_key("solver.cg_max_iterations", "20000", 1, 1e7,
-              "CG iterations before a step fails with exit code 3"),
+      int_key(
+          "solver.cg_max_iterations", "20000", 1, 1e7,
+          "CG iterations per solve; in spread a solve that reaches it is retried with half the step, up to "
+          "6 times; then (in relax at once) the run stops with exit code 3"),
       string_key(
           "solver.preconditioner", "multigrid", {"block_jacobi", "multigrid"},
           "preconditioner of Γ: multigrid (V-cycle on the icosphere hierarchy; block_jacobi where a mesh "

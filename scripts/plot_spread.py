@@ -16,6 +16,7 @@ import csv
 import json
 import os
 import sys
+import tomllib
 
 os.environ.setdefault("HDF5_USE_FILE_LOCKING", "FALSE")
 import h5py  # noqa: E402
@@ -113,8 +114,19 @@ def plot_cells(out, h5, tri):
     plt.close(fig)
 
 
+def plane_z(h5):
+    """The substrate's height (m) from the scene the run stored (contact.plane_z_m, default 0)."""
+    text = h5.attrs.get("scene", "")
+    text = text.decode() if isinstance(text, bytes) else text
+    try:
+        return float(tomllib.loads(text).get("contact", {}).get("plane_z_m", 0.0))
+    except (tomllib.TOMLDecodeError, ValueError):
+        return 0.0
+
+
 def plot_side_views(out, h5):
     fl = frames(h5)
+    z_plane = plane_z(h5) * 1e6
     picks = distinct(fl, [0.0, 0.1, 0.35, 0.9, fl[-1][0]])
     fig, axes = plt.subplots(1, len(picks), figsize=(3.0 * len(picks), 3.0), sharey=True)
     axes = np.atleast_1d(axes)
@@ -122,7 +134,7 @@ def plot_side_views(out, h5):
         x = np.asarray(g["x"]) * 1e6
         band = np.abs(x[:, 1]) < 0.25 * np.ptp(x[:, 1]) / 2 + 1e-9
         ax.plot(x[band, 0], x[band, 2], ".", ms=2, color="C0")
-        ax.axhline(0, color="k", lw=1)
+        ax.axhline(z_plane, color="k", lw=1)
         ax.set_aspect("equal")
         ax.set_title(f"t = {t:.3f} s", fontsize=9)
         ax.set_xlabel("x (µm)")

@@ -238,7 +238,7 @@ def report(folder):
         f0, f1 = ref[0].get("r_cc_final_m"), var[0].get("r_cc_final_m")
         early = None if not r0 or r1 is None else r1 / r0 - 1
         final = None if not f0 or f1 is None else f1 / f0 - 1
-        measured = (f"r_cc at 0.01 s {fmt(pct(early), '+.1f', '%')}, "
+        measured = (f"r_cc at 0.01 s {fmt(pct(early), '+.2f', '%')}, "
                     f"final {fmt(pct(final), '+.2f', '%')}")
         if no_effect:
             ok = None if final is None else abs(final) <= 0.02

@@ -179,7 +179,10 @@ class TimeStepper {
     for (int c = 0; c < n_; ++c)
       if (h_cap[c] > 0) {
         stepping[c] = 1;
-        h[c] = std::min(h_next_[c], h_cap[c]);
+        // Fixed steps: a cap under 1.5 Δt is the rest of the run, taken as one step (no sliver of a step
+        // after the last full one; an accumulated time a rounding short of t_end ends the run too).
+        h[c] =
+            !settings_.adaptive && h_cap[c] < 1.5 * settings_.dt ? h_cap[c] : std::min(h_next_[c], h_cap[c]);
       }
     if (!settings_.adaptive) extrapolate_warm_start(model, stepping);
     model.compute_forces();

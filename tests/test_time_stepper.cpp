@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <random>
 #include <string>
+#include <tuple>
 
 #include "core/host_copy.hpp"
 #include "solvers/time_stepper.hpp"
@@ -91,6 +92,31 @@ TEST(TimeStepper, FixedStepsAreTheForwardEulerLoop) {
       iterations_a, iterations_plain, max_distance(xa, xp));
   EXPECT_LT(iterations_a, iterations_plain);
   EXPECT_LT(max_distance(xa, xp), 1e-12);  // the CG tolerance's trace, ~1e-6 of the 40 nm perturbation
+}
+
+// Fixed steps end on t_end: the rest of the run under 1.5 Δt is one step (10.3 Δt: ten steps, the last
+// 1.3 Δt), and 200 steps of 6 µs end at 1.2 ms without an extra sliver of a step for the rounding of their
+// sum.
+TEST(TimeStepper, FixedStepsLandOnTheEndTime) {
+  const HostMesh sphere = make_icosphere(1, 3.25e-6);
+  for (const auto& [t_end, want_steps, want_last] :
+       {std::tuple{10.3 * 6e-6, 10, 1.3 * 6e-6}, std::tuple{1.2e-3, 200, 6e-6}}) {
+    CortexModel<Exec> m(Exec(), {HostCell(sphere)}, table1());
+    perturb(m, 0.04e-6, 3);
+    TimeStepSettings s;
+    s.dt = 6e-6;
+    TimeStepper<Exec> stepper(m, s);
+    int steps = 0;
+    double last = 0;
+    while (stepper.time() < t_end * (1 - 1e-12) && steps < 1000) {
+      const double remaining = t_end - stepper.time();
+      last = stepper.step(m, CgSettings{}, remaining < 1.5 * s.dt ? remaining : INFINITY, [](double) {}).h;
+      ++steps;
+    }
+    EXPECT_EQ(steps, want_steps) << "t_end " << t_end;
+    EXPECT_NEAR(last, want_last, 1e-9 * want_last);
+    EXPECT_NEAR(stepper.time(), t_end, 1e-12 * t_end);
+  }
 }
 
 // Adaptive steps: relaxing the perturbed cell over 1.5 ms, the error against a reference (fixed steps of 1

@@ -94,6 +94,10 @@ inline CgSettings cg_settings_from_scene(const Scene& scene) {
   s.abs_tol = scene.get_real("solver.cg_abs_tol_N");
   s.rel_tol = scene.get_real("solver.cg_rel_tol");
   s.max_iterations = static_cast<int>(scene.get_int("solver.cg_max_iterations"));
+  if (!(s.abs_tol > 0) && !(s.rel_tol > 0))
+    throw SceneError(
+        "solver.cg_abs_tol_N = 0 with solver.cg_rel_tol = 0 is not allowed: CG could stop only at an exactly "
+        "zero residual; set one of them > 0");
   return s;
 }
 

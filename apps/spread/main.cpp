@@ -5,7 +5,9 @@
 //   series.csv   t_s,r_cc_m,contact_area_m2,area_m2,volume_m3,cg_iterations,dt_s,height_m,contact_load_N,
 //                elastic_energy_J,dE_dt_W,contact_power_W,dissipation_W,energy_residual_W
 //                (log-spaced in time: output.series_per_decade rows per decade, every step at the start, and
-//                the last step; each row the state at its t_s)
+//                the last step; each row the state at its t_s, the end of its step, written once the next
+//                step has accepted that step; contact_power_W and dissipation_W are the step's, at its start
+//                with its velocity, dE_dt_W the change over it: the energy balance of the step)
 //   spread.h5/.xmf  mesh, series (every column of series.csv), frames (every output.frame_every_s and at
 //                t = 0.1, 0.35, 0.9 s) with the per-node normal force and pressure, cortex tension (eq. 1)
 //                and stretch; not with output.hdf5 = false
@@ -14,7 +16,8 @@
 // A new run removes an earlier run's files from its folder first (a restart continues them).
 //   r_cc.png, cells.png, side_views.png (scripts/plot_spread.py) unless --no-plot
 //   checkpoint.h5 the state at the end, on Ctrl-C and every output.checkpoint_every_s of wall time;
-//                `spread --restart <out>/checkpoint.h5` continues bit for bit (docs/CHECKPOINTS.md)
+//                `spread --restart <out>/checkpoint.h5` continues a stopped run bit for bit; a finished run
+//                continued to a later t_end differs from one run there directly (docs/CHECKPOINTS.md)
 // Ctrl-C (SIGINT) or SIGTERM: the loop stops after the current step, a checkpoint is written, the files are
 // closed and valid, the summary says "interrupted": true; exit code 130.
 //
@@ -64,8 +67,10 @@ int main(int argc, char** argv) {
   app.add_flag(
       "--no-plot", [&](std::int64_t) { so.plot = false; }, "Do not write the PNG plots");
   std::vector<double> window;
-  app.add_option("--early-window-s", window,
-                 "Time window FROM,TO (s) of the early power-law fit (default 0.01,0.1)")
+  app.add_option(
+         "--early-window-s", window,
+         "Time window FROM,TO (s) of the early power-law fit (default 0.01,0.1; a --restart keeps the "
+         "run's own unless given)")
       ->delimiter(',')
       ->expected(2);
   app.add_option("--restart", so.restart,
@@ -86,6 +91,7 @@ int main(int argc, char** argv) {
     if (window.size() == 2) {
       so.early_from_s = window[0];
       so.early_to_s = window[1];
+      so.early_window_given = true;
     }
     dcm::spread_app::run(options, so);
   });

@@ -50,10 +50,11 @@ struct SpreadOptions {
   // Window of the early power-law fit: from 10 ms (after the first triangles have touched down, r_cc of a few
   // edge lengths) to 0.1 s (the paper: still the t^1/2 regime at 100 ms). docs/model/spread.md.
   double early_from_s = 1e-2, early_to_s = 1e-1;
-  std::string restart;      // checkpoint to continue from
-  long long max_steps = 0;  // stop after this many steps (counted from the run's start), 0: no limit
-  bool check = false;       // validate the scene and options, write nothing, run nothing
-  std::string batch;        // file with one member per line: run them as one batch
+  bool early_window_given = false;  // --early-window-s on the command line (a restart keeps the run's own)
+  std::string restart;              // checkpoint to continue from
+  long long max_steps = 0;          // stop after this many steps (counted from the run's start), 0: no limit
+  bool check = false;               // validate the scene and options, write nothing, run nothing
+  std::string batch;                // file with one member per line: run them as one batch
 };
 
 // The columns of series.csv and of spread.h5's /series, one row per sample.

@@ -106,6 +106,11 @@ void prepare_member(Member& m) {
     m.restart = read_checkpoint(so.restart);
     if (m.restart->text("app") != "spread")
       throw IoError(so.restart + ": a checkpoint of '" + m.restart->text("app") + "', not of spread");
+    if (!so.early_window_given && m.restart->arrays.count("app.early_window_s")) {  // since session 28
+      const std::vector<double>& w = m.restart->array("app.early_window_s", 2);
+      m.so.early_from_s = w[0];
+      m.so.early_to_s = w[1];
+    }
     const double steps_done = m.restart->array("app.progress").at(0);  // Progress::step
     if (so.max_steps > 0 && static_cast<double>(so.max_steps) <= steps_done)
       throw SceneError("--max-steps " + std::to_string(so.max_steps) + " is not allowed with --restart " +
@@ -178,6 +183,7 @@ std::string batch_difference(const Member& a, const Member& b) {
                {"time.error_tol_m", a.steps.error_tol_m, b.steps.error_tol_m},
                {"time.dt_min_s", a.steps.dt_min, b.steps.dt_min},
                {"time.dt_max_s", a.steps.dt_max, b.steps.dt_max},
+               {"time.contact_change", a.steps.contact_change, b.steps.contact_change},
                {"solver.cg_abs_tol_N", a.cg.abs_tol, b.cg.abs_tol},
                {"solver.cg_rel_tol", a.cg.rel_tol, b.cg.rel_tol},
                {"solver.cg_max_iterations", static_cast<double>(a.cg.max_iterations),

@@ -71,6 +71,7 @@ void write_checkpoint_now(Member& m, const Model& model, const Stepper& stepper,
   c.put("app.series_rows", m.series_rows);
   c.put("app.pending_row", m.pending_row);
   c.put("app.h_last", m.h_last);
+  c.put("app.early_window_s", std::vector<double>{m.so.early_from_s, m.so.early_to_s});
   c.put("app.frames", m.h5 ? static_cast<double>(m.h5->frames()) : 0.0);
   if (m.h5) m.h5->flush();
   write_checkpoint(m.checkpoint_path, c);

@@ -131,7 +131,8 @@ bool plan_step(std::vector<Member>& ms, const Stepper& stepper, std::vector<doub
     any_running = true;
     m.t = stepper.time(m.cell);
     m.index = static_cast<long long>(m.p.step);
-    // The last step lands on t_end (a fixed-step run's last step may be up to 1.5 Δt long, as before).
+    // The last step lands on t_end (a fixed-step run's last step is up to 1.5 Δt long:
+    // solvers/time_stepper.hpp).
     const double remaining = m.t_end - m.t;
     m.h_cap = m.steps.adaptive ? remaining : (remaining < 1.5 * m.dt ? remaining : INFINITY);
     cap[m.cell] = m.h_cap;

@@ -38,4 +38,13 @@ out=$("$spread" --batch "$work/bad.txt" --quiet 2>&1); rc=$?
 [ $rc -eq 2 ] || { echo "mixed mesh sizes: exit $rc, expected 2"; exit 1; }
 echo "$out" | grep -q "mesh.nodes = 642" || { echo "mixed mesh sizes: message '$out'"; exit 1; }
 [ ! -e "$work/bad" ] || { echo "a refused batch wrote $work/bad"; exit 1; }
-echo "batch members equal their runs alone; restart of a member ok; mixed batch refused: $out"
+# The adaptive contact-change limit is the stepper's, one for the batch: members that differ in it are refused.
+cat > "$work/bad2.txt" <<EOT
+$base --out "$work/bad2/a"
+$base --set time.contact_change=0 --out "$work/bad2/b"
+EOT
+out2=$("$spread" --batch "$work/bad2.txt" --quiet 2>&1); rc=$?
+[ $rc -eq 2 ] || { echo "mixed time.contact_change: exit $rc, expected 2"; exit 1; }
+echo "$out2" | grep -q "time.contact_change = 0" || { echo "mixed time.contact_change: message '$out2'"; exit 1; }
+[ ! -e "$work/bad2" ] || { echo "a refused batch wrote $work/bad2"; exit 1; }
+echo "batch members equal their runs alone; restart of a member ok; mixed batches refused: $out / $out2"
