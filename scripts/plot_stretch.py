@@ -43,8 +43,13 @@ def main():
             err = [[yy - float(r[lo]) for yy, r in zip(y, m)], [float(r[hi]) - yy for yy, r in zip(y, m)]]
             ax.errorbar(mf, y, yerr=err, fmt="o", color=color, mfc="none", capsize=3,
                         label=f"Mills 2004 {key[:2]}")
+    else:
+        print(f"plot_stretch.py: {mills} not found; the plot shows dcm's curves without Mills 2004 "
+              "(pass --data DIR)", file=sys.stderr)
     suresh = os.path.join(args.data, "suresh2005.csv")
-    if os.path.exists(suresh):
+    if not os.path.exists(suresh):
+        print(f"plot_stretch.py: {suresh} not found; the plot shows no Suresh 2005 points", file=sys.stderr)
+    else:
         s = read_csv(suresh)
         ax.plot([float(r["F_pN"]) for r in s], [float(r["DA_um"]) for r in s], "s", color="C0", ms=4, alpha=0.5,
                 label="Suresh 2005 DA")

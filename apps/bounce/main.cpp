@@ -440,7 +440,9 @@ std::string num(double v) {
 }
 
 void require(bool ok, const std::string& option, double value, const std::string& allowed) {
-  if (!ok) throw SceneError(option + " = " + num(value) + " is out of range (allowed " + allowed + ")");
+  if (!ok)
+    throw SceneError(option + " = " + detail::format_real(value) + " is out of range (allowed " + allowed +
+                     ")");
 }
 
 int subdivisions_for(int nodes) {
@@ -459,9 +461,12 @@ double hertz_contact_time(double K, double R, double mass, double v, double& del
 
 void validate(const BounceOptions& o) {
   require(!o.nodes.empty(), "--nodes", 0, "one or more icosphere node counts");
-  for (int n : o.nodes)
-    require(subdivisions_for(n) >= 0, "--nodes", n,
+  for (std::size_t k = 0; k < o.nodes.size(); ++k) {
+    require(subdivisions_for(o.nodes[k]) >= 0, "--nodes", o.nodes[k],
             "icosphere node counts 12, 42, 162, 642, 2562, 10242, 40962");
+    for (std::size_t j = 0; j < k; ++j)
+      require(o.nodes[j] != o.nodes[k], "--nodes", o.nodes[k], "each node count once");
+  }
   require(o.bounces >= 1 && o.bounces <= 20, "--bounces", o.bounces, "1 .. 20");
   require(o.quadrature_points == 0 || o.quadrature_points == 1 || o.quadrature_points == 3 ||
               o.quadrature_points == 7 || o.quadrature_points == 16,
@@ -478,7 +483,7 @@ void validate(const BounceOptions& o) {
           "--reference-steps-per-contact", o.reference_steps_per_contact, "1000 .. 1e7");
   require(o.threads >= 0 && o.threads <= 4096, "--threads", o.threads, "0 .. 4096");
   require(o.drop_height > 0 && std::isfinite(o.drop_height), "--drop-height-m", o.drop_height, "0 < H, m");
-  require(o.frames_per_bounce >= 0 && o.frames_per_bounce * o.bounces <= 1000, "--frames-per-bounce",
+  require(o.frames_per_bounce >= 0 && o.frames_per_bounce <= 1000 / o.bounces, "--frames-per-bounce",
           o.frames_per_bounce,
           "0 .. " + std::to_string(1000 / o.bounces) + " with --bounces " + std::to_string(o.bounces) +
               ": at most 1000 frames in bounce.h5 (0: none)");

@@ -6,14 +6,24 @@
 #include <utility>
 #include <vector>
 
+#include "core/errors.hpp"
 #include "core/host_mesh.hpp"
+#include "core/scene.hpp"
 
 namespace dcm {
+
+// --pulled-fraction's range (CLI::Range lets NaN through): a one-line error naming the value.
+inline void check_pulled_fraction(double fraction) {
+  if (!(fraction >= 0.001 && fraction <= 0.25))
+    throw SceneError("--pulled-fraction = " + detail::format_real(fraction) +
+                     " is out of range: allowed 0.001 .. 0.25");
+}
 
 // Node indices of the outermost `fraction` of the nodes at the −x and +x ends (at least one each). Nodes
 // level with the last one taken (|Δx| within 1e-9 of the cell's length, the mirror images of a symmetric
 // mesh) are taken too, so the choice depends on the geometry only, not on how the nodes are numbered, and
-// each end gets every node of its outermost rings.
+// each end gets every node of its outermost rings. The apps check `fraction` with check_pulled_fraction
+// before they build a mesh.
 inline std::pair<std::vector<int>, std::vector<int>> pulled_nodes(const HostMesh& m, double fraction) {
   std::vector<int> order(m.nodes.size());
   std::iota(order.begin(), order.end(), 0);

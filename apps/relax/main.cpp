@@ -63,6 +63,7 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
   if (!(ro.duration_s > 0 && ro.duration_s <= 100))
     throw SceneError("--duration-s = " + detail::format_real(ro.duration_s) +
                      " is out of range: allowed > 0 .. 100");
+  check_pulled_fraction(ro.pulled_fraction);
   if (stop_after_check("relax", options, scene)) return;
   const std::string out = prepare_output_dir(options, scene);
   remove_earlier_outputs(

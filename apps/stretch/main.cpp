@@ -1,8 +1,10 @@
 // stretch: the optical-tweezers experiment of the paper (its Figure 2; Mills et al. 2004): the outermost
-// 5% of the nodes at each end of the cell are pulled along x with ±F/n each, the cell is brought to
-// equilibrium, and the axial and transverse diameters D_A, D_T are recorded for every force.
-// Writes <out>/series.csv (F_N,DA_m,DT_m), <out>/summary.json, <out>/stretch.h5 (+ .xmf) with one frame
-// per force, and <out>/stretch.png against ../shared/data/stretching when plotting is available.
+// nodes of the cell, 2.5% at each end (the paper's 5% in total; --pulled-fraction), are pulled along x with
+// ±F/n each, the cell is brought to equilibrium, and the axial and transverse diameters D_A (x extent) and
+// D_T (y extent) are recorded for every force. Writes <out>/series.csv (F_N,DA_m,DT_m), <out>/summary.json,
+// <out>/stretch.h5 (+ .xmf) with one frame per force (the frame's "time" is the force in N: ParaView's time
+// control steps through the forces), and <out>/stretch.png against ../shared/data/stretching when plotting
+// is available.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -42,6 +44,7 @@ void run(const AppOptions& options, const StretchOptions& so) {
   for (double f : so.forces_pN)
     if (!(f >= 0 && f <= 1e4))
       throw SceneError("--forces-pN = " + detail::format_real(f) + " is out of range: allowed 0 .. 10000");
+  check_pulled_fraction(so.pulled_fraction);
   if (stop_after_check("stretch", options, scene)) return;
   const std::string out = prepare_output_dir(options, scene);
   remove_earlier_outputs(
