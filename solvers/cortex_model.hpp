@@ -546,6 +546,13 @@ class CortexModel {
 
   static std::string unconverged_message(const CgResult& r, const CgSettings& settings) {
     char msg[300];
+    if (r.breakdown) {
+      std::snprintf(msg, sizeof msg,
+                    "conjugate gradients broke down at iteration %d: p.Gamma p = %.3g W is not positive "
+                    "(the friction operator is not positive definite along a search direction)",
+                    r.iterations, r.curvature);
+      return msg;
+    }
     std::snprintf(
         msg, sizeof msg,
         "conjugate gradients did not converge in %d iterations (residual %.3g N, tolerance %.3g N, "

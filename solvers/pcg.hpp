@@ -30,6 +30,10 @@ struct CgResult {
   int iterations = 0;
   double residual_norm = 0, rhs_norm = 0;
   bool converged = false;
+  // p·Γp ≤ 0 (or not finite) along a search direction: Γ is not positive definite there; the solve stops
+  // unconverged at that iteration. `curvature` holds the offending p·Γp.
+  bool breakdown = false;
+  double curvature = 0;
 };
 
 template <class MemorySpace>
@@ -224,12 +228,23 @@ CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& pr
   for (int it = 1; it <= settings.max_iterations; ++it) {
     apply(p, q);
     cg_detail::segment_dots(space, sums, p, q, pq);
+    bool stopped = false;
+    for (int s = 0; s < n_seg; ++s) {
+      if (!active[s] || pq[s] > 0) continue;  // !(p·Γp > 0): also NaN
+      res[s].iterations = it;
+      res[s].converged = false;
+      res[s].breakdown = true;
+      res[s].curvature = pq[s];
+      active[s] = 0;
+      --n_active;
+      stopped = true;
+    }
+    if (n_active == 0) break;
     for (int s = 0; s < n_seg; ++s) w.alpha_host(s) = active[s] ? rz[s] / pq[s] : 0.0;
     Kokkos::deep_copy(space, alpha, w.alpha_host);
     cg_detail::update_iterate(space, sums, seg, alpha, p, q, x, r);
     Kokkos::deep_copy(space, sums.result_host, sums.result);
     space.fence();
-    bool stopped = false;
     for (int s = 0; s < n_seg; ++s) {
       if (!active[s]) continue;
       res[s].iterations = it;

@@ -145,6 +145,50 @@ TEST(FrictionOperator, LumpedSubstrateFrictionIsBlockDiagonalAndKeepsRigidForces
   EXPECT_LT((ta - tb).norm(), 1e-12 * tb.norm()) << "Σ_i w_i Γ_t u = Σ_ij β_i β_j Γ_t u = Γ_t u";
 }
 
+// out = −out (a free function: CUDA takes no extended lambda inside a test body).
+void negate(const Exec& space, const Vector& out) {
+  Kokkos::parallel_for(
+      "dcm::test::negate", Kokkos::RangePolicy<Exec>(space, 0, static_cast<int>(out.extent(0))),
+      KOKKOS_LAMBDA(const int i) {
+        for (int d = 0; d < 3; ++d) out(i, d) = -out(i, d);
+      });
+}
+
+// An operator that is not positive definite: CG stops at the first direction with p·Γp ≤ 0 and says so,
+// instead of stepping by a negative or infinite α.
+TEST(Pcg, ReportsBreakdownOnAnIndefiniteOperator) {
+  const FrictionSetup s(2);
+  const Vector f = s.random_vector(7, 1e-12);
+  Vector v("v", s.mesh.n_nodes);
+  CgWorkspace<Mem> w(s.mesh.n_nodes);
+  CgSettings settings;
+  settings.abs_tol = 0;
+  settings.rel_tol = 1e-12;
+  const Exec space;
+  const CgResult r = pcg_solve(
+      space,
+      [&](const Vector& in, const Vector& out) {  // −Γ
+        apply_friction(space, s.mesh, s.op, in, out);
+        negate(space, out);
+      },
+      [&](const Vector& in, const Vector& out) { apply_block_jacobi(space, s.op, in, out); }, f, v, w,
+      settings);
+  EXPECT_FALSE(r.converged);
+  EXPECT_TRUE(r.breakdown);
+  EXPECT_EQ(r.iterations, 1);
+  EXPECT_LT(r.curvature, 0.0);
+  const auto vh = to_host_vector(v);
+  for (const double x : vh) ASSERT_EQ(x, 0.0) << "no step taken along a direction of negative curvature";
+
+  // The same solve with Γ itself converges and reports no breakdown.
+  const CgResult ok = pcg_solve(
+      space, [&](const Vector& in, const Vector& out) { apply_friction(space, s.mesh, s.op, in, out); },
+      [&](const Vector& in, const Vector& out) { apply_block_jacobi(space, s.op, in, out); }, f, v, w,
+      settings);
+  EXPECT_TRUE(ok.converged);
+  EXPECT_FALSE(ok.breakdown);
+}
+
 TEST(Pcg, AgreesWithEigenReferenceOn642Nodes) {
   const FrictionSetup s(3);  // 642 nodes, paper parameters
   const Eigen::MatrixXd a = s.assemble();
