@@ -17,7 +17,7 @@ r_cc and contact angle against each swept key). Running the same command again f
 missing: finished members are kept, interrupted ones continue from their checkpoint.
 Exit codes: 0 all members finished, 2 bad input (nothing written), 3 a member failed numerically, 130 stopped.
 """
-import argparse, csv, itertools, json, math, os, random, shutil, signal, subprocess, sys, time
+import argparse, csv, hashlib, itertools, json, math, os, random, shutil, signal, subprocess, sys, time
 
 try:
     import tomllib
@@ -136,6 +136,12 @@ def load_scan(path):
             doc = tomllib.load(f)
     except FileNotFoundError:
         raise ScanError(f"{path}: no such scan file")
+    except IsADirectoryError:
+        raise ScanError(f"{path}: is a folder, not a scan file")
+    except OSError as e:
+        raise ScanError(f"{path}: cannot be read: {e.strerror}")
+    except UnicodeDecodeError:
+        raise ScanError(f"{path}: not valid TOML: not UTF-8 text")
     except tomllib.TOMLDecodeError as e:
         raise ScanError(f"{path}: not valid TOML: {e}")
     allowed = {"name", "base", "mode", "set", "sweep", "samples", "seed"}
@@ -143,13 +149,21 @@ def load_scan(path):
         if k not in allowed:
             raise ScanError(f"{path}: unknown key '{k}' (allowed: {', '.join(sorted(allowed))})")
     name = doc.get("name", os.path.splitext(os.path.basename(path))[0])
-    if not isinstance(name, str) or not name or any(c in name for c in "/\\ "):
+    if not isinstance(name, str) or not name or name in (".", "..") or any(c in name for c in "/\\ "):
         raise ScanError(f"{path}: name = {name!r} is not allowed: a non-empty word without / or spaces")
     base = doc.get("base")
+    if base is not None and (not isinstance(base, str) or not base):
+        raise ScanError(f"{path}: base = {base!r} is not allowed: the path of a scene file, in quotes")
+    base_sha256 = ""  # the base scene's content: a member's results are its own only with the same base
     if base is not None:
         base = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(path)), base))
         if not os.path.isfile(base):
             raise ScanError(f"{path}: base = '{doc['base']}': no such scene file ({base})")
+        try:
+            with open(base, "rb") as f:
+                base_sha256 = hashlib.sha256(f.read()).hexdigest()
+        except OSError as e:
+            raise ScanError(f"{path}: base = '{doc['base']}': cannot be read: {e.strerror}")
     mode = doc.get("mode", "one_at_a_time")
     if mode not in ("one_at_a_time", "grid", "latin_hypercube"):
         raise ScanError(f"{path}: mode = '{mode}' is not allowed: choose one_at_a_time, grid or latin_hypercube")
@@ -172,6 +186,9 @@ def load_scan(path):
         raise ScanError(f"{path}: [set] and [sweep] must be tables of scene keys")
     if not sweep:
         raise ScanError(f"{path}: [sweep] is empty: give at least one scene key with its values")
+    for key in sweep:
+        if key in fixed:
+            raise ScanError(f"{path}: {key} is in both [set] and [sweep]: give it in one of them")
     for key in list(fixed) + list(sweep):
         if isinstance(fixed.get(key, sweep.get(key)), dict) and key in fixed:
             raise ScanError(f"{path}: set.{key}: write the key in quotes, e.g. \"{key}\" = value")
@@ -198,7 +215,7 @@ def load_scan(path):
             label = ", ".join(f"{k}={v:.4g}" for k, v in swept.items())
         else:
             label = ", ".join(f"{k}={fmt(v)}" for k, v in swept.items()) or "base"
-        out.append({"id": f"m{i:03d}", "label": label, "swept": swept, "sets": sets})
+        out.append({"id": f"m{i:03d}", "label": label, "swept": swept, "sets": sets, "base_sha256": base_sha256})
     return {"name": name, "base": base, "mode": mode, "sweep_keys": list(values), "members": out}
 
 
@@ -211,11 +228,17 @@ def spread_cmd(spread, scan, member, out_dir=None, extra=()):
     return cmd + list(extra)
 
 
+def same_member(stored, member):
+    """True when a member.json's content describes `member`: the same --set values on a base scene of the same
+    content (a member folder of another base, or of the base before an edit, holds another run)."""
+    return stored.get("sets") == member["sets"] and stored.get("base_sha256") == member["base_sha256"]
+
+
 def member_state(mdir, member):
     """done, resume (a checkpoint of the same member), or new."""
     try:
         with open(os.path.join(mdir, "member.json")) as f:
-            if json.load(f)["sets"] != member["sets"]:
+            if not same_member(json.load(f), member):
                 return "new"
         with open(os.path.join(mdir, "summary.json")) as f:
             s = json.load(f)
@@ -227,12 +250,12 @@ def member_state(mdir, member):
 
 
 def results_of(mdir, member):
-    """True when mdir's files are this member's: its member.json holds the same sets. A folder left by an
-    earlier scan file with other values (the member not launched in this run) is not reported."""
+    """True when mdir's files are this member's: its member.json holds the same sets and base. A folder left by
+    an earlier scan file with other values or base (the member not launched in this run) is not reported."""
     try:
         with open(os.path.join(mdir, "member.json")) as f:
-            return json.load(f)["sets"] == member["sets"]
-    except (OSError, ValueError, KeyError):
+            return same_member(json.load(f), member)
+    except (OSError, ValueError, KeyError, AttributeError):
         return False
 
 
@@ -285,12 +308,16 @@ def write_h5(scan, out, rows):
             src_path = os.path.join(out, "members", m["id"], "spread.h5")
             if not os.path.isfile(src_path) or not results_of(os.path.dirname(src_path), m):
                 continue
-            with h5py.File(src_path, "r") as src:
-                if "series" in src:
-                    src.copy(src["series"], mg, "series")
-                frames = sorted(src["frames"]) if "frames" in src else []
-                if frames:
-                    src.copy(src["frames"][frames[-1]], mg, "final_frame")
+            try:
+                with h5py.File(src_path, "r") as src:
+                    if "series" in src:
+                        src.copy(src["series"], mg, "series")
+                    frames = sorted(src["frames"]) if "frames" in src else []
+                    if frames:
+                        src.copy(src["frames"][frames[-1]], mg, "final_frame")
+            except (OSError, KeyError) as e:  # a run killed while writing it (out of memory, a signal)
+                print(f"{PROG}: warning: {src_path} cannot be read ({e}): member {m['id']} has no series in "
+                      f"scan.h5", file=sys.stderr)
     os.replace(tmp, os.path.join(out, "scan.h5"))
 
 
@@ -302,7 +329,7 @@ def remove_plots(out, names=("r_cc_grid.png", "sensitivity.png")):
 
 
 def plot(scan, out):
-    remove_plots(out, ("sensitivity.png",))  # drawn again by a latin_hypercube scan only
+    remove_plots(out)  # an earlier run's plots are not of these results, also when this plot fails
     plotter = os.path.join(os.path.dirname(os.path.abspath(__file__)), "scan_plot.py")
     if not os.path.isfile(plotter):
         plotter = os.path.join(os.environ.get("DCM_SOURCE_DIR", ""), "apps", "scan", "scan_plot.py")
@@ -545,9 +572,10 @@ def main():
         threads = a.threads or max(1, per_rank_cores // max(1, min(jobs, n_todo)))
         if not a.quiet:
             changed = [m["id"] for m in queue if os.path.isfile(os.path.join(out, "members", m["id"], "member.json"))
-                       and member_state(os.path.join(out, "members", m["id"]), m) == "new"]
+                       and not results_of(os.path.join(out, "members", m["id"]), m)]
             if changed:
-                print(f"{PROG}: {len(changed)} member folder(s) hold a run of other settings (the scan file changed): "
+                print(f"{PROG}: {len(changed)} member folder(s) hold a run of other settings or another base scene (the "
+                      f"scan file or its base changed): "
                       f"run again: {' '.join(changed[:10])}{' ...' if len(changed) > 10 else ''}", flush=True)
             ids = {m["id"] for m in members}
             extra = sorted(d for d in os.listdir(os.path.join(out, "members")) if d not in ids)
@@ -582,6 +610,7 @@ def main():
                     remote.update(msg["status"])
                     for mid, files in msg["files"].items():
                         mdir = os.path.join(out, "members", mid)
+                        shutil.rmtree(mdir, ignore_errors=True)  # no file of an earlier run next to these
                         os.makedirs(mdir, exist_ok=True)
                         for name, data in files.items():
                             with open(os.path.join(mdir, name), "wb") as f:
