@@ -76,7 +76,10 @@ constexpr MinBound kExcl = MinBound::Exclusive;
 
 std::vector<ParamSpec> make_schema() {
   return {
-      string_key("name", "", {}, "run name; output goes to out/<name> unless output.dir is set"),
+      string_key(
+          "name", "", {},
+          "run name; output goes to out/<name> unless output.dir is set (empty: the scene file's stem, or "
+          "default without a scene file)"),
 
       string_key("mesh.shape", "sphere", {"sphere", "evans_fung"},
                  "sphere = icosphere of radius mesh.radius_m; evans_fung = Evans–Fung biconcave RBC of "
@@ -118,7 +121,7 @@ std::vector<ParamSpec> make_schema() {
 
       bool_key("contact.plane", "false",
                "a substrate plane z = contact.plane_z_m with adhesion (contact.law) and substrate friction "
-               "(spread: true unless the scene sets false)"),
+               "(spread: always on; false is refused)"),
       real_key("contact.plane_z_m", "0", -1e-3, 1e-3, kIncl, "m", "height of the substrate plane"),
       string_key("contact.law", "maugis_dugdale", {"maugis_dugdale", "derjaguin"},
                  "the adhesion model: maugis_dugdale = the paper's rounded triangles with the Maugis–Dugdale "
@@ -135,7 +138,9 @@ std::vector<ParamSpec> make_schema() {
                  "1/cos(tilt) times)"),
       real_key("contact.start_gap_m", "10e-9", -1e-6, 1e-5, kIncl, "m",
                "spread: the cell's lowest node starts this far above the plane (below contact.h0_m, or "
-               "higher with gravity on; negative: pressed into the plane)"),
+               "higher with gravity on: body.gravity_m_per_s2 > 0, body.density_excess_kg_per_m3 > 0 and a "
+               "solver.cg_abs_tol_N below the weight's force norm, which the error message gives; negative: "
+               "pressed into the plane)"),
       real_key("contact.W_J_per_m2", "1e-3", 0, 1, kIncl, "J/m²", "work of adhesion"),
       real_key("contact.h0_m", "20e-9", 0, 1e-6, kExcl, "m", "range of adhesion (Dugdale)"),
       real_key("contact.gamma_n_N_s_per_m3", "8e9", 0, 1e15, kIncl, "N·s/m³", "normal substrate friction"),
@@ -157,10 +162,11 @@ std::vector<ParamSpec> make_schema() {
           "off)"),
 
       real_key("time.dt_s", "6e-6", 0, 1, kExcl, "s", "time step (with time.adaptive: the first step)"),
-      real_key("time.t_end_s", "1.2", 0, 1e6, kExcl, "s", "simulated time"),
+      real_key("time.t_end_s", "1.2", 0, 1e6, kExcl, "s",
+               "simulated time (spread; relax runs for --duration-s, stretch to equilibrium)"),
       bool_key("time.adaptive", "false",
                "error-controlled time steps (Euler against Heun, docs/model/time_stepping.md); false: the "
-               "fixed time.dt_s of the paper"),
+               "fixed time.dt_s of the paper (spread; relax always steps with time.dt_s)"),
       real_key("time.error_tol_m", "1e-9", 0, 1e-6, kExcl, "m",
                "adaptive: allowed local position error per step"),
       real_key("time.dt_min_s", "1e-9", 0, 1, kExcl, "s", "adaptive: smallest step"),
@@ -212,8 +218,10 @@ std::vector<ParamSpec> make_schema() {
 
       string_key("output.dir", "", {}, "output directory (empty: out/<name>)"),
       bool_key("output.hdf5", "true", "write the HDF5 + XDMF output"),
-      real_key("output.frame_every_s", "0.05", 0, 1e6, kExcl, "s",
-               "simulated time between HDF5 frames (spread also writes t = 0.1, 0.35, 0.9 s and the end)"),
+      real_key(
+          "output.frame_every_s", "0.05", 0, 1e6, kExcl, "s",
+          "simulated time between HDF5 frames (spread also writes t = 0.1, 0.35, 0.9 s and the end; relax "
+          "writes a frame every 20 × --sample-every steps)"),
       int_key("output.series_per_decade", "40", 1, 10000,
               "rows of series.csv per decade of simulated time (log-spaced; every step for the first ten)"),
       real_key("output.checkpoint_every_s", "600", 0, 1e7, kIncl, "s",

@@ -4,7 +4,8 @@
 // kernels/plane_contact.hpp), integrated by velocity Verlet with a rotation update by the exponential map.
 // The rebound heights of icospheres of several resolutions are compared with those of a perfect sphere
 // obeying the same continuum law P(δ) = K a³/R, integrated by RK4 with a tiny step. Writes
-// <out>/summary.json, <out>/series.csv (t_s, then the height of each ball's lowest point) and <out>/bounce.h5
+// <out>/summary.json, <out>/series.csv (t_s, reference_m: the perfect sphere's, then
+// nodes_<N>_m: the height of each ball's lowest point) and <out>/bounce.h5
 // + .xmf (the balls and the perfect sphere side by side, --frames-per-bounce frames per bounce: the paper's
 // Video S3 in ParaView).
 #include <algorithm>

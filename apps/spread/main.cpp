@@ -73,9 +73,11 @@ int main(int argc, char** argv) {
          "run's own unless given)")
       ->delimiter(',')
       ->expected(2);
-  app.add_option("--restart", so.restart,
-                 "Continue the run whose checkpoint this is (<out>/checkpoint.h5), in its folder; the scene "
-                 "comes from the checkpoint (--set may change time.t_end_s and output.* only)")
+  app.add_option(
+         "--restart", so.restart,
+         "Continue the run whose checkpoint this is (<out>/checkpoint.h5), in its folder; the scene "
+         "comes from the checkpoint (--set may change time.t_end_s and output.* except output.dir and "
+         "output.hdf5)")
       ->check(CLI::ExistingFile);
   app.add_option("--max-steps", so.max_steps,
                  "Stop after this many steps in all (a checkpoint is written; --restart continues)")

@@ -1,7 +1,8 @@
 // stretch: the optical-tweezers experiment of the paper (its Figure 2; Mills et al. 2004): the outermost
 // nodes of the cell, 2.5% at each end (the paper's 5% in total; --pulled-fraction), are pulled along x with
 // ±F/n each, the cell is brought to equilibrium, and the axial and transverse diameters D_A (x extent) and
-// D_T (y extent) are recorded for every force. Writes <out>/series.csv (F_N,DA_m,DT_m), <out>/summary.json,
+// D_T (y extent) are recorded for every force. Writes <out>/series.csv (F_N,DA_m,DT_m,newton_steps,
+// max_residual_force_N), <out>/summary.json,
 // <out>/stretch.h5 (+ .xmf) with one frame per force (the frame's "time" is the force in N: ParaView's time
 // control steps through the forces), and <out>/stretch.png against ../shared/data/stretching when plotting
 // is available.
