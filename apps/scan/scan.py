@@ -80,12 +80,23 @@ def sweep_values(key, spec):
             raise ScanError(f"sweep.{key}.spacing = '{spacing}' is not allowed: choose linear or log")
         if spacing == "log" and not (start > 0 and stop > 0):
             raise ScanError(f"sweep.{key}: log spacing needs start > 0 and stop > 0 (got {start}, {stop})")
+        if num > 1 and start == stop:  # num identical members: the same run num times
+            raise ScanError(f"sweep.{key} = {spec}: start = stop gives {num} identical members; use num = 1")
         if num == 1:
-            return [start]
-        if spacing == "log":
+            values = [start]
+        elif spacing == "log":
             a, b = math.log(start), math.log(stop)
-            return [math.exp(a + (b - a) * i / (num - 1)) for i in range(num)]
-        return [start + (stop - start) * i / (num - 1) for i in range(num)]
+            values = [math.exp(a + (b - a) * i / (num - 1)) for i in range(num)]
+        else:
+            values = [start + (stop - start) * i / (num - 1) for i in range(num)]
+        if isinstance(spec["start"], int) and isinstance(spec["stop"], int):  # an integer key (mesh.nodes, ...)
+            if any(v != round(v) for v in values):
+                raise ScanError(f"sweep.{key} = {spec}: integer start and stop give values that are not whole "
+                                f"numbers; give a list of integers or floats for start and stop")
+            values = [int(round(v)) for v in values]
+        if len(set(values)) != len(values):
+            raise ScanError(f"sweep.{key} = {spec}: two members get the same value; give fewer num")
+        return values
     raise ScanError(f"sweep.{key} = {spec!r}: give a list of values or a table {{start, stop, num, spacing}}")
 
 
@@ -569,7 +580,7 @@ def main():
         queue = [m for m in members if member_state(os.path.join(out, "members", m["id"]), m) != "done"]
         n_todo = len(queue)
         status = {m["id"]: "done" for m in members if all(m["id"] != q["id"] for q in queue)}
-        threads = a.threads or max(1, per_rank_cores // max(1, min(jobs, n_todo)))
+        threads = a.threads or max(1, per_rank_cores // max(1, min(jobs, math.ceil(n_todo / a.chunk))))
         if not a.quiet:
             changed = [m["id"] for m in queue if os.path.isfile(os.path.join(out, "members", m["id"], "member.json"))
                        and not results_of(os.path.join(out, "members", m["id"]), m)]
