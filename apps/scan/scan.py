@@ -279,6 +279,8 @@ def collect(scan, out, spread_ok):
         try:
             if not results_of(mdir, m):
                 raise OSError("another member's results")
+            if row["status"].startswith("failed"):  # a failed restart leaves the interrupted run's summary
+                raise OSError("no results of a failed run")
             with open(os.path.join(mdir, "summary.json")) as f:
                 s = json.load(f)
             row.update({k: ("" if s.get(k) is None else s[k]) for k in SUMMARY_KEYS})  # null: not measured
