@@ -121,7 +121,7 @@ std::vector<ParamSpec> make_schema() {
 
       bool_key("contact.plane", "false",
                "a substrate plane z = contact.plane_z_m with adhesion (contact.law) and substrate friction "
-               "(spread: always on; false is refused)"),
+               "(spread: always on, false is refused; stretch and relax refuse true)"),
       real_key("contact.plane_z_m", "0", -1e-3, 1e-3, kIncl, "m", "height of the substrate plane"),
       string_key("contact.law", "maugis_dugdale", {"maugis_dugdale", "derjaguin"},
                  "the adhesion model: maugis_dugdale = the paper's rounded triangles with the Maugis–Dugdale "

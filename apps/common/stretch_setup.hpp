@@ -19,6 +19,15 @@ inline void check_pulled_fraction(double fraction) {
                      " is out of range: allowed 0.001 .. 0.25");
 }
 
+// The optical-tweezers cell floats free: a spreading scene's substrate plane (through the cell's centre)
+// would cut it. A one-line error instead of a run that cannot reach equilibrium.
+inline void check_no_plane(const char* app, const Scene& scene) {
+  if (scene.get_bool("contact.plane"))
+    throw SceneError(std::string("contact.plane = true is not allowed in ") + app +
+                     ": the optical-tweezers cell has no substrate (the plane would cut it); use a scene "
+                     "without it or --set contact.plane=false");
+}
+
 // Node indices of the outermost `fraction` of the nodes at the −x and +x ends (at least one each). Nodes
 // level with the last one taken (|Δx| within 1e-9 of the cell's length, the mirror images of a symmetric
 // mesh) are taken too, so the choice depends on the geometry only, not on how the nodes are numbered, and

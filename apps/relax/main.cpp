@@ -64,6 +64,7 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
     throw SceneError("--duration-s = " + detail::format_real(ro.duration_s) +
                      " is out of range: allowed > 0 .. 100");
   check_pulled_fraction(ro.pulled_fraction);
+  check_no_plane("relax", scene);
   if (stop_after_check("relax", options, scene)) return;
   const std::string out = prepare_output_dir(options, scene);
   remove_earlier_outputs(

@@ -46,6 +46,7 @@ void run(const AppOptions& options, const StretchOptions& so) {
     if (!(f >= 0 && f <= 1e4))
       throw SceneError("--forces-pN = " + detail::format_real(f) + " is out of range: allowed 0 .. 10000");
   check_pulled_fraction(so.pulled_fraction);
+  check_no_plane("stretch", scene);
   if (stop_after_check("stretch", options, scene)) return;
   const std::string out = prepare_output_dir(options, scene);
   remove_earlier_outputs(
