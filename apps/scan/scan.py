@@ -449,6 +449,9 @@ def run_members(a, out, next_member, serve, jobs, threads, say):
                 if state == "done":
                     status[m["id"]] = "done"
                     continue
+                if batch and (state == "resume" or from_batch):  # it runs alone: the partial batch goes first,
+                    alone.insert(0, m)                           # this member in the next free slot (--jobs)
+                    break
                 if state == "resume":  # a restart continues one run
                     launch([m], [a.spread, "--restart", os.path.join(mdir, "checkpoint.h5"), "--quiet", "--no-plot"],
                            os.path.join(mdir, "spread.log"))
