@@ -145,6 +145,16 @@ TEST(FrictionOperator, LumpedSubstrateFrictionIsBlockDiagonalAndKeepsRigidForces
   EXPECT_LT((ta - tb).norm(), 1e-12 * tb.norm()) << "Σ_i w_i Γ_t u = Σ_ij β_i β_j Γ_t u = Γ_t u";
 }
 
+// Block-Jacobi PCG of Γ v = f on s's cell (v: the start and the result).
+CgResult block_jacobi_solve(const FrictionSetup& s, const Vector& f, const Vector& v, CgWorkspace<Mem>& w,
+                            const CgSettings& settings) {
+  const Exec space;
+  return pcg_solve(
+      space, [&](const Vector& in, const Vector& out) { apply_friction(space, s.mesh, s.op, in, out); },
+      [&](const Vector& in, const Vector& out) { apply_block_jacobi(space, s.op, in, out); }, f, v, w,
+      settings);
+}
+
 // out = −out (a free function: CUDA takes no extended lambda inside a test body).
 void negate(const Exec& space, const Vector& out) {
   Kokkos::parallel_for(
@@ -181,10 +191,7 @@ TEST(Pcg, ReportsBreakdownOnAnIndefiniteOperator) {
   for (const double x : vh) ASSERT_EQ(x, 0.0) << "no step taken along a direction of negative curvature";
 
   // The same solve with Γ itself converges and reports no breakdown.
-  const CgResult ok = pcg_solve(
-      space, [&](const Vector& in, const Vector& out) { apply_friction(space, s.mesh, s.op, in, out); },
-      [&](const Vector& in, const Vector& out) { apply_block_jacobi(space, s.op, in, out); }, f, v, w,
-      settings);
+  const CgResult ok = block_jacobi_solve(s, f, v, w, settings);
   EXPECT_TRUE(ok.converged);
   EXPECT_FALSE(ok.breakdown);
 }
@@ -201,11 +208,7 @@ TEST(Pcg, AgreesWithEigenReferenceOn642Nodes) {
   CgSettings settings;
   settings.abs_tol = 0;
   settings.rel_tol = 1e-12;
-  const Exec space;
-  const CgResult r = pcg_solve(
-      space, [&](const Vector& in, const Vector& out) { apply_friction(space, s.mesh, s.op, in, out); },
-      [&](const Vector& in, const Vector& out) { apply_block_jacobi(space, s.op, in, out); }, f, v, w,
-      settings);
+  const CgResult r = block_jacobi_solve(s, f, v, w, settings);
   std::printf("  642 nodes: block-Jacobi PCG, cold start, %d iterations to 1e-12 relative\n", r.iterations);
   ASSERT_TRUE(r.converged);
   const auto vh = to_host_vector(v);
@@ -214,10 +217,7 @@ TEST(Pcg, AgreesWithEigenReferenceOn642Nodes) {
 
   // Warm start from the solution: converged at once (round-off may ask for a few iterations: 2 with the
   // nodes in subdivision order, 3 in the locality order of session 22).
-  const CgResult again = pcg_solve(
-      space, [&](const Vector& in, const Vector& out) { apply_friction(space, s.mesh, s.op, in, out); },
-      [&](const Vector& in, const Vector& out) { apply_block_jacobi(space, s.op, in, out); }, f, v, w,
-      settings);
+  const CgResult again = block_jacobi_solve(s, f, v, w, settings);
   EXPECT_LE(again.iterations, 3);
 }
 
@@ -230,11 +230,7 @@ TEST(Pcg, ReportsNonConvergence) {
   settings.abs_tol = 0;
   settings.rel_tol = 1e-14;
   settings.max_iterations = 3;
-  const Exec space;
-  const CgResult r = pcg_solve(
-      space, [&](const Vector& in, const Vector& out) { apply_friction(space, s.mesh, s.op, in, out); },
-      [&](const Vector& in, const Vector& out) { apply_block_jacobi(space, s.op, in, out); }, f, v, w,
-      settings);
+  const CgResult r = block_jacobi_solve(s, f, v, w, settings);
   EXPECT_FALSE(r.converged);
   EXPECT_EQ(r.iterations, 3);
 }
@@ -247,11 +243,7 @@ TEST(Pcg, DiagonalSystemWithoutDashpotsIsOneStep) {
   CgSettings settings;
   settings.abs_tol = 0;
   settings.rel_tol = 1e-13;
-  const Exec space;
-  const CgResult r = pcg_solve(
-      space, [&](const Vector& in, const Vector& out) { apply_friction(space, s.mesh, s.op, in, out); },
-      [&](const Vector& in, const Vector& out) { apply_block_jacobi(space, s.op, in, out); }, f, v, w,
-      settings);
+  const CgResult r = block_jacobi_solve(s, f, v, w, settings);
   EXPECT_TRUE(r.converged);
   EXPECT_LE(r.iterations, 1);
 }
