@@ -15,7 +15,8 @@ summary as attributes, its series and final frame), scan.json (the members and t
 arguments) and r_cc_grid.png (r_cc(t) per swept key; a latin_hypercube scan also sensitivity.png, the final
 r_cc and contact angle against each swept key). Running the same command again finishes what is
 missing: finished members are kept, interrupted ones continue from their checkpoint.
-Exit codes: 0 all members finished, 2 bad input (nothing written), 3 a member failed numerically, 130 stopped.
+Exit codes: 0 all members finished, 1 a member failed otherwise (a crash, a full disk: its spread.log says why),
+2 bad input (nothing written), 3 a member failed numerically, 130 stopped.
 """
 import argparse, csv, hashlib, itertools, json, math, os, random, shutil, signal, subprocess, sys, time
 
@@ -404,6 +405,17 @@ def prepare(a):
     return scan, out
 
 
+def member_result(rc):
+    """A member's status from its spread's exit code (a negative code: the signal that ended it)."""
+    if rc in (130, -signal.SIGINT, -signal.SIGTERM):  # stopped (a signal before spread's handler was set)
+        return "interrupted"
+    if rc == 3:
+        return "failed (numerical)"
+    if rc < 0:
+        return f"failed (killed by signal {-rc})"
+    return "done" if rc == 0 else f"failed (exit {rc})"
+
+
 def run_members(a, out, next_member, serve, jobs, threads, say):
     """Runs members as spread processes, jobs at a time, until next_member() returns None or a signal arrives;
     with a.chunk > 1 up to a.chunk new members share one process (spread --batch). serve() is called while waiting
@@ -484,7 +496,7 @@ def run_members(a, out, next_member, serve, jobs, threads, say):
                 continue
             log.close()
             del running[key]
-            result = {0: "done", 3: "failed (numerical)", 130: "interrupted"}.get(rc, f"failed (exit {rc})")
+            result = member_result(rc)
             if len(ms) > 1:
                 for m in ms:  # each member's log: the batch's
                     shutil.copyfile(log.name, os.path.join(out, "members", m["id"], "spread.log"))
@@ -521,9 +533,12 @@ def member_files(out, ids):
 
 
 def main():
-    ap = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0],
-                                 epilog="Scan files: scans/quick.toml, scans/figure5.toml, scans/sensitivity.toml; modes "
-                                        "one_at_a_time, grid and latin_hypercube; format in docs/SCANS.md. "
+    ap = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n", 1)[1],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter,
+                                 epilog="Example: scan scans/quick.toml --jobs 2 --threads 1   (4 members of 162 nodes, "
+                                        "under a minute on 2 cores)\n"
+                                        "Scan files: scans/quick.toml, scans/figure5.toml, scans/sensitivity.toml; modes "
+                                        "one_at_a_time, grid\nand latin_hypercube; format in docs/SCANS.md. "
                                         "Over several machines: mpirun -np P scan SCAN.toml (docs/SCANS.md).")
     ap.add_argument("scan_file", metavar="SCAN.toml")
     ap.add_argument("--out", help="output folder (default out/<scan name>)")
@@ -664,7 +679,14 @@ def main():
             print(f"{PROG}: stopped; run the same command again to finish the missing members", file=sys.stderr)
             rc = 130
         else:
-            rc = 3 if any(s.startswith("failed") for s in status.values()) else 0
+            failed = sorted(mid for mid, s in status.items() if s.startswith("failed"))
+            if failed:
+                print(f"{PROG}: {len(failed)} member(s) failed: "
+                      + ", ".join(f"{mid} ({status[mid][len('failed ('):-1]})" for mid in failed[:10])
+                      + (" ..." if len(failed) > 10 else "")
+                      + f"; why: {os.path.join(out, 'members', '<id>', 'spread.log')}", file=sys.stderr)
+            numerical = any(status[mid] == "failed (numerical)" for mid in failed)
+            rc = 3 if numerical else (1 if failed else 0)
         return comm.bcast(rc, root=0) if comm else rc
 
     # Ranks 1 .. P-1: ask rank 0 for one member at a time.
