@@ -673,7 +673,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--bounces", o.bounces, "Number of bounces, 1 .. 20")->capture_default_str();
   app.add_option("--drop-height-m", o.drop_height,
-                 "Initial height of the lowest point above the plane (m), > 0")
+                 "Initial height of the lowest point above the plane (m), > 0, at most the height whose "
+                 "largest overlap is R/10 (0.138 m for the defaults; a refused value names it)")
       ->capture_default_str();
   app.add_option("--quadrature-points", o.quadrature_points,
                  "Contact integration: 0 exact polar integration, or the paper's 1, 3, 7, 16-point rules")

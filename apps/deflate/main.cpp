@@ -213,6 +213,14 @@ int main(int argc, char** argv) {
   CLI::App app{
       "deflate: the paper's biconcave start, a sphered cell deflated and relaxed (docs/VALIDATION.md)",
       "deflate"};
+  app.footer(
+      "Writes in --out: summary.json (area, volume, reduced volume, diameter, centre and largest thickness,\n"
+      "against the Evans-Fung cell), profile.csv (thickness against the distance from the axis), shape.csv\n"
+      "(node positions), deflate.h5 + deflate.xmf (the squashed start and the equilibrium, for ParaView).\n"
+      "Examples:\n  deflate                       (642 nodes, a few seconds)\n"
+      "  deflate --nodes 2562 --out out/deflate2562   (minutes)\n"
+      "Exit codes: 0 success, 2 bad input or an unwritable --out (one line on stderr, nothing written),\n3 numerical failure (the "
+      "Newton iteration did not converge), 1 internal error.");
   Options o;
   app.add_option("--nodes", o.nodes, "icosphere node count: 162, 642, 2562 or 10242 (default 642)");
   app.add_option("--volume-fraction", o.volume_fraction,
