@@ -405,6 +405,11 @@ def prepare(a):
     return scan, out
 
 
+def batch_word(w):
+    """A word of a spread --batch member line: quoted, its backslashes and double quotes escaped."""
+    return '"' + w.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
 def member_result(rc):
     """A member's status from its spread's exit code (a negative code: the signal that ended it)."""
     if rc in (130, -signal.SIGINT, -signal.SIGTERM):  # stopped (a signal before spread's handler was set)
@@ -485,7 +490,7 @@ def run_members(a, out, next_member, serve, jobs, threads, say):
                 with open(listing, "w") as f:
                     for m in batch:
                         words = spread_cmd("", {"base": m["base"]}, m, os.path.join(out, "members", m["id"]))[1:]
-                        f.write(" ".join('"' + w + '"' for w in words) + "\n")
+                        f.write(" ".join(batch_word(w) for w in words) + "\n")
                 launch(batch, [a.spread, "--batch", listing, "--quiet", "--no-plot"],
                        os.path.join(batches, batch[0]["id"] + ".log"))
         serve(stop)

@@ -48,16 +48,24 @@ Scene spread_scene(const AppOptions& options, const SpreadOptions& so, const Che
   return scene;
 }
 
-// Splits a member line into words; "double quotes" keep spaces.
+// Splits a member line into words: "double quotes" keep spaces, a backslash takes the next character as it
+// is (\" and \\ in a word), and # at the start of a word outside quotes begins a comment.
 std::vector<std::string> split_words(const std::string& line) {
   std::vector<std::string> words;
   std::string w;
   bool quoted = false, have = false;
-  for (const char ch : line) {
-    if (ch == '"') {
+  for (std::size_t k = 0; k < line.size(); ++k) {
+    const char ch = line[k];
+    if (ch == '\\') {
+      if (k + 1 == line.size()) throw SceneError("a \\ at the end of: " + line);
+      w += line[++k];
+      have = true;
+    } else if (ch == '"') {
       quoted = !quoted;
       have = true;
-    } else if (!quoted && (ch == ' ' || ch == '\t')) {
+    } else if (!quoted && !have && ch == '#') {
+      break;
+    } else if (!quoted && (ch == ' ' || ch == '\t' || ch == '\r')) {
       if (have) words.push_back(w);
       w.clear();
       have = false;
@@ -204,7 +212,12 @@ std::vector<Member> read_batch(const std::string& path, const AppOptions& common
   while (std::getline(in, line)) {
     ++number;
     const std::string where = path + ":" + std::to_string(number) + ": ";
-    const std::vector<std::string> words = split_words(line.substr(0, line.find('#')));
+    std::vector<std::string> words;
+    try {
+      words = split_words(line);
+    } catch (const SceneError& e) {
+      throw SceneError(where + e.what());
+    }
     if (words.empty()) continue;
     Member& m = ms.emplace_back();
     m.options.quiet = common.quiet;
