@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """Draws <scan out>/r_cc_grid.png: one panel per swept key (the paper's Figure 5 layout), r_cc(t) of its
-members on log-log axes with a t^(1/2) guide; one_at_a_time scans add the base member in black. A
+members on log-log axes with a t^(1/2) guide; one_at_a_time scans add the base member in black. A member
+that did not finish (summary.csv's status: failed, interrupted) is drawn dashed up to where it stopped, marked x
+there, its status in the legend. A
 latin_hypercube scan (every member varies every key) colours all members in each panel by that key's value
 (dark: low, yellow: high) and also draws sensitivity.png: the final r_cc and the free-fit contact angle of
 every member against each swept key (from summary.csv).
@@ -36,6 +38,14 @@ def main():
     rows = math.ceil(n / cols)
     fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.4 * rows), squeeze=False)
     base = next((m for m in scan["members"] if not m["swept"]), None)
+    status = {}  # a member that did not finish: its curve is the part it ran, drawn dashed and marked x
+    try:
+        with open(os.path.join(out, "summary.csv")) as f:
+            status = {r["id"]: r["status"] for r in csv.DictReader(f)}
+    except (OSError, KeyError):
+        pass
+    unfinished = lambda mid: status.get(mid, "done") != "done"
+    note = lambda mid: f" ({status[mid]})" if unfinished(mid) else ""
     for i, key in enumerate(keys):
         ax = axes[i // cols][i % cols]
         members = [m for m in scan["members"] if key in m["swept"]]
@@ -46,12 +56,17 @@ def main():
             t, r = series(out, m["id"])
             if t:
                 label = f"{m['swept'][key]:.3g}" if isinstance(m["swept"][key], float) else str(m["swept"][key])
-                ax.loglog(t, r, color=cmap(j / max(1, len(members) - 1)), lw=1.3,
-                          label=label if len(members) <= 8 else None)
+                colour = cmap(j / max(1, len(members) - 1))
+                ax.loglog(t, r, color=colour, lw=1.3, ls=(0, (2, 2)) if unfinished(m["id"]) else "-",
+                          label=label + note(m["id"]) if len(members) <= 8 or unfinished(m["id"]) else None)
+                if unfinished(m["id"]):
+                    ax.plot(t[-1], r[-1], "x", color=colour, ms=7, mew=1.5)
         if base:
             t, r = series(out, base["id"])
             if t:
-                ax.loglog(t, r, color="k", lw=1.0, ls="--", label="base")
+                ax.loglog(t, r, color="k", lw=1.0, ls="--", label="base" + note(base["id"]))
+                if unfinished(base["id"]):
+                    ax.plot(t[-1], r[-1], "x", color="k", ms=7, mew=1.5)
         all_t = [v for m in members for v in series(out, m["id"])[0]]
         if all_t:
             t0, t1 = min(all_t), max(all_t)
