@@ -247,7 +247,9 @@ struct BeforeStep {
       // The run's last step always writes a row (the same test as account_step's m.last: a fixed-step run
       // whose steps add up to t_end within rounding ends on a step shorter than its cap).
       const bool ends_run = t + h_planned[m.cell] >= m.t_end * (1 - 1e-12);
-      m.sample = t >= p.next_sample || m.index < 10 || h_planned[m.cell] >= m.h_cap || ends_run;
+      // A row when the step ends at or past the next sample time (its row's time is the step's end).
+      m.sample = t + h_planned[m.cell] >= p.next_sample * (1 - 1e-12) || m.index < 10 ||
+                 h_planned[m.cell] >= m.h_cap || ends_run;
       any_sample = any_sample || m.sample;
     }
     if (any_sample) {  // each cell's own sums (solvers/cortex_model.hpp): the bits of its run alone

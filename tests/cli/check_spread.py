@@ -26,6 +26,22 @@ def fail(msg):
     sys.exit(1)
 
 
+def per_decade_of(out):
+    """output.series_per_decade of the run (the scene in spread.h5's attribute), or None without h5py/spread.h5."""
+    try:
+        import h5py
+        with h5py.File(os.path.join(out, "spread.h5"), "r") as f:
+            scene = f.attrs["scene"]
+    except Exception:
+        return None
+    scene = scene.decode() if isinstance(scene, bytes) else str(scene)
+    for line in scene.splitlines():
+        key, _, value = line.partition("=")
+        if key.strip() in ("series_per_decade", "output.series_per_decade"):
+            return float(value.split("#")[0])
+    return None
+
+
 def main():
     out = sys.argv[1]
     interrupted = "--interrupted" in sys.argv
@@ -47,6 +63,17 @@ def main():
         ta, tb, hb = float(a["t_s"]), float(b["t_s"]), float(b["dt_s"])
         if not tb > ta or tb - hb < ta - 1e-5 * hb:  # dt_s has 6 digits
             fail(f"row at t = {tb} s (dt_s = {hb}) after the row at t = {ta} s")
+    # Log-spaced rows (output.series_per_decade): after the first ten steps, the step of each row starts
+    # before the next sample time of the row before it (the first step that reaches it writes the row; until
+    # session 29 the first step that started past it, so the rows lay up to a step apart beyond the spacing).
+    per_decade = per_decade_of(out)
+    if per_decade:
+        factor = 10 ** (1 / per_decade)
+        for a, b in zip(rows[10:], rows[11:]):
+            ta, tb, hb = float(a["t_s"]), float(b["t_s"]), float(b["dt_s"])
+            if tb - hb > ta * factor + 1e-5 * hb:
+                fail(f"row at t = {tb} s (dt_s = {hb}): its step starts past the sample time {ta * factor} s "
+                     f"after the row at t = {ta} s (series_per_decade = {per_decade}): a row was skipped")
     if not interrupted and not float(rows[-1]["r_cc_m"]) > float(rows[1]["r_cc_m"]):
         fail("r_cc did not grow")
     s = json.load(open(os.path.join(out, "summary.json")))
