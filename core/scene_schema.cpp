@@ -99,7 +99,16 @@ std::vector<ParamSpec> make_schema() {
       real_key("cortex.nu", "0.4", 0, 0.5, kIncl, "", "Poisson ratio of the cortex"),
       real_key("cortex.k_s_N_per_m", "3.2e-6", 0, 1, kExcl, "N/m", "FENE+POW spring constant"),
       real_key("cortex.x_max", "2.05", 1, 10, kExcl, "", "maximum bond extension d_max/d*"),
-      real_key("cortex.c_N_s_per_m", "1.5e-6", 0, 1, kIncl, "N·s/m", "bond dashpot coefficient"),
+      real_key(
+          "cortex.c_N_s_per_m", "1.5e-6", 0, 1, kIncl, "N·s/m",
+          "cortex damping c (Table 1): the membrane's in-plane shear viscosity (N·s/m = Pa·s·m), or each "
+          "bond's dashpot coefficient, as cortex.c_reading says"),
+      string_key(
+          "cortex.c_reading", "surface_viscosity", {"surface_viscosity", "bond"},
+          "surface_viscosity: c is the membrane's shear viscosity, Hochmuth's t_c = c/μ; each bond's dashpot "
+          "is 4c/√3 (axial; c/√3 with cortex.dashpot = relative), the triangular network's lattice factor "
+          "(docs/MODEL.md); bond: c is each bond's dashpot coefficient (eq. 25 read literally; dcm's "
+          "reading until session 29, relaxation time 0.085-0.09 s against the paper's 0.1-0.3 s)"),
       string_key(
           "cortex.dashpot", "axial", {"axial", "relative"},
           "axial: c damps the bond-length rate only (eq. 25); relative: c damps the whole relative velocity "

@@ -12,7 +12,8 @@
 namespace dcm {
 
 // Table 1 constants as the energies of docs/model/ use them (docs/MODEL.md section 3 says why):
-// k_s (N/m), x_max, k_b (J), c (N·s/m) as given; cortex.k_a, cortex.k_d (N/m) and cortex.k_v (Pa) are the
+// k_s (N/m), x_max, k_b (J) as given; c (N·s/m) the membrane's shear viscosity, each bond's dashpot
+// 4c/√3 (or c itself with cortex.c_reading = bond); cortex.k_a, cortex.k_d (N/m) and cortex.k_v (Pa) are the
 // constants of E = k (X − X*)² / (2 X*) for the triangle areas, the cell area and the cell volume.
 inline MechanicsParams mechanics_from_scene(const Scene& scene) {
   MechanicsParams p;
@@ -22,8 +23,12 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
   p.k_area_local = scene.get_real("cortex.k_a");
   p.k_area_global = scene.get_real("cortex.k_d");
   p.k_volume = scene.get_real("cortex.k_v");
-  p.dashpot = scene.get_real("cortex.c_N_s_per_m");
-  p.dashpot_transverse = scene.get_string("cortex.dashpot") == "relative" ? p.dashpot : 0.0;
+  const bool relative = scene.get_string("cortex.dashpot") == "relative";
+  const double c = scene.get_real("cortex.c_N_s_per_m");
+  p.dashpot = scene.get_string("cortex.c_reading") == "surface_viscosity"
+                  ? bond_dashpot_of_surface_viscosity(c, relative)
+                  : c;
+  p.dashpot_transverse = relative ? p.dashpot : 0.0;
   p.viscosity = scene.get_real("fluid.eta_Pa_s");
   p.h_min = scene.get_real("geometry.h_min_per_m");
   p.multigrid = scene.get_string("solver.preconditioner") == "multigrid";

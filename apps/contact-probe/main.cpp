@@ -97,12 +97,14 @@ int main(int argc, char** argv) {
       "(regime 0 none, 1 gap branch, 2 quadrature/exact, 3 small disc, 4 full contact; loads repulsive > 0)",
       "contact-probe"};
   app.footer(
-      "Columns: triangle, r_m (mean distance of its nodes from the axis), z_min_m, z_max_m (above the plane),\n"
+      "Columns: triangle, r_m (mean distance of its nodes from the axis), z_min_m, z_max_m (above the "
+      "plane),\n"
       "normal_z, sphere_radius_m and sphere_overlap_m (its rounded sphere), regime, load_N, node0..2,\n"
       "z0_m..z2_m, f0_N..f2_N (the nodes' shares of the load), contact_area_m2.\n"
       "Examples:\n  contact-probe out/default/checkpoint.h5 > contact.csv\n"
       "  contact-probe out/default/checkpoint.h5 --set contact.quadrature_points=16 --all > all.csv\n"
-      "Exit codes: 0 success, 2 bad input or an unreadable checkpoint (one line on stderr), 1 internal error.");
+      "Exit codes: 0 success, 2 bad input or an unreadable checkpoint (one line on stderr), 1 internal "
+      "error.");
   std::string path;
   std::vector<std::string> sets;
   bool all = false;

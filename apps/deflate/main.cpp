@@ -219,7 +219,8 @@ int main(int argc, char** argv) {
       "(node positions), deflate.h5 + deflate.xmf (the squashed start and the equilibrium, for ParaView).\n"
       "Examples:\n  deflate                       (642 nodes, a few seconds)\n"
       "  deflate --nodes 2562 --out out/deflate2562   (minutes)\n"
-      "Exit codes: 0 success, 2 bad input or an unwritable --out (one line on stderr, nothing written),\n3 numerical failure (the "
+      "Exit codes: 0 success, 2 bad input or an unwritable --out (one line on stderr, nothing written),\n3 "
+      "numerical failure (the "
       "Newton iteration did not converge), 1 internal error.");
   Options o;
   app.add_option("--nodes", o.nodes, "icosphere node count: 162, 642, 2562 or 10242 (default 642)");

@@ -86,7 +86,8 @@ int main(int argc, char** argv) {
          "--batch", so.batch,
          "Run the members listed in this file as one batch (one model, one launch per kernel for all; "
          "docs/SCANS.md): one member per line, [SCENE.toml] [--set KEY=VALUE]... --out DIR (\"double "
-         "quotes\" around a word with spaces, \\\" and \\\\ inside one, # at a word's start begins a comment). Each "
+         "quotes\" around a word with spaces, \\\" and \\\\ inside one, # at a word's start begins a "
+         "comment). Each "
          "member's folder gets what its run alone writes, with the same numbers")
       ->check(CLI::ExistingFile);
   return dcm::run_app(app, argc, argv, [&] {
