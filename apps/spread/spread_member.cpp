@@ -26,6 +26,8 @@ Scene spread_scene(const AppOptions& options, const SpreadOptions& so, const Che
     throw SceneError("--restart " + so.restart + " with --out " + options.out_dir +
                      ": a restart continues in the folder of its checkpoint; give no --out");
   Scene scene = Scene::from_string(restart->text("scene"), so.restart);
+  // A checkpoint of sessions 1-28 (its scene has no cortex.c_reading) continues with c per bond, as it ran.
+  if (!scene.was_set("cortex.c_reading")) scene.set("cortex.c_reading=bond");
   for (const std::string& set : options.sets) {
     const std::string key = set.substr(0, set.find('='));
     if ((key != "time.t_end_s" && key.rfind("output.", 0) != 0) || key == "output.hdf5" ||
