@@ -106,13 +106,16 @@ std::vector<ParamSpec> make_schema() {
       string_key(
           "cortex.c_reading", "surface_viscosity", {"surface_viscosity", "bond"},
           "surface_viscosity: c is the membrane's shear viscosity, Hochmuth's t_c = c/μ; each bond's dashpot "
-          "is 4c/√3 (axial; c/√3 with cortex.dashpot = relative), the triangular network's lattice factor "
-          "(docs/MODEL.md); bond: c is each bond's dashpot coefficient (eq. 25 read literally; dcm's "
-          "reading until session 29, relaxation time 0.085-0.09 s against the paper's 0.1-0.3 s)"),
+          "c_b is 4c/√3 (axial; 2c/√3 with cortex.dashpot = relative), the triangular network's lattice "
+          "factor (docs/MODEL.md); bond: c_b = c (eq. 25 read literally, as the project's reading guide "
+          "writes it; dcm's reading until session 29, relaxation time 0.085-0.09 s against the paper's "
+          "0.1-0.3 s)"),
       string_key(
           "cortex.dashpot", "axial", {"axial", "relative"},
-          "axial: c damps the bond-length rate only (eq. 25); relative: c damps the whole relative velocity "
-          "c (v_i − v_j), as eq. 32 writes it (also damps bending and rigid rotation)"),
+          "axial: the bond dashpot c_b (cortex.c_reading) damps the bond-length rate only (eq. 25); "
+          "relative: "
+          "it damps the whole relative velocity c_b (v_i − v_j), as eq. 32 writes it (also damps bending and "
+          "rigid rotation)"),
       real_key("cortex.k_b_J", "240e-21", 0, 1e-15, kIncl, "J", "bending stiffness"),
       real_key("cortex.k_a", "6e-3", 0, 10, kIncl, "N/m",
                "local area constraint, E = Σ k_a (A_t − A_t*)²/(2A_t*); Table 1's 6e3 read in µN/m "

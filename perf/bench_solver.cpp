@@ -1,6 +1,7 @@
-// Solving Γ v = F (paper parameters: η = 0.8 mPa·s, r = 3.25 µm, c = 1.5e-6 N·s/m) on a randomly
-// perturbed icosphere of 642, 2562 or 10242 nodes, random pN-scale right-hand side, cold start, to 1e-8
-// relative, with each preconditioner; and the per-step set-up of each.
+// Solving Γ v = F (η = 0.8 mPa·s, r = 3.25 µm, bond dashpots c_b = 1.5e-6 N·s/m: Table 1's c per bond, the
+// reading of sessions 1-28; the apps' default since session 29 is c_b = 4c/√3, docs/MODEL.md "Table 1's c")
+// on a randomly perturbed icosphere of 642, 2562 or 10242 nodes, random pN-scale right-hand side, cold start,
+// to 1e-8 relative, with each preconditioner; and the per-step set-up of each.
 //   build/bin/bench_solver [--benchmark_filter=...]
 // Counters: iterations (PCG), nodes. Time per solve is the benchmark's own time.
 #include <random>

@@ -77,15 +77,17 @@ struct FrictionOperator {
         cell_coef_host(Kokkos::create_mirror_view(cell_coef)) {}
 };
 
-// The bond dashpot coefficient of a membrane with in-plane shear viscosity eta (N·s/m = Pa·s·m): a
-// triangular network of axial dashpots c_b (eq. 25) shears with viscosity √3 c_b / 4, the lattice factor of
-// its springs' shear modulus μ = √3 k / 4, so that Hochmuth's relaxation time η/μ is c_b / k; with the whole
-// relative velocity damped (eq. 32's c_b (v_i − v_j)), √3 c_b. dcm reads Table 1's c this way by default
-// (cortex.c_reading = surface_viscosity; docs/MODEL.md, "Table 1's c"). Checked against the continuum
-// membrane's dissipation on the icosphere in tests/test_solver.cpp.
+// The bond dashpot coefficient of a membrane with in-plane shear viscosity eta (N·s/m = Pa·s·m). A triangular
+// network of axial dashpots c_b (eq. 25) deforms with shear viscosity √3 c_b / 4 and second (Lamé) viscosity
+// the same, the lattice factors of its springs' μ = λ = √3 k / 4, so that Hochmuth's relaxation time η/μ is
+// c_b / k. Dashpots on the whole relative velocity (eq. 32's c_b (v_i − v_j)) give a pure in-plane strain
+// rate the shear viscosity √3 c_b / 2 (no second viscosity) and also damp tilt and rotation, which a
+// membrane's viscosity does not. dcm reads Table 1's c this way by default (cortex.c_reading =
+// surface_viscosity; docs/MODEL.md, "Table 1's c"). Both checked against the continuum membrane's dissipation
+// on the icosphere in tests/test_solver.cpp.
 inline double bond_dashpot_of_surface_viscosity(double eta, bool relative) {
   const double sqrt3 = 1.7320508075688772;
-  return relative ? eta / sqrt3 : 4.0 * eta / sqrt3;
+  return relative ? 2.0 * eta / sqrt3 : 4.0 * eta / sqrt3;
 }
 
 enum FrictionCoef : int { kDashpot = 0, kDashpotTransverse = 1, kGammaN = 2, kGammaT = 3, kPin = 4 };

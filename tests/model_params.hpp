@@ -1,5 +1,6 @@
 #pragma once
-// The paper's Table 1 cortex as dcm reads it (docs/MODEL.md), for tests that build a CortexModel.
+// The paper's Table 1 cortex as dcm read it until session 29 (docs/MODEL.md; the dashpot per bond), for tests
+// that build a CortexModel.
 #include <cmath>
 
 #include "solvers/cortex_model.hpp"
@@ -13,8 +14,8 @@ inline MechanicsParams table1_cortex() {
   p.k_area_local = 6e-3;     // N/m
   p.k_area_global = 6e-3;    // N/m
   p.k_volume = 1e4;          // Pa
-  p.dashpot = 1.5e-6;        // N·s/m
-  p.viscosity = 0.8e-3;      // Pa·s
+  p.dashpot = 1.5e-6;    // N·s/m per bond: Table 1's c per bond (cortex.c_reading = bond; the apps: 4c/√3)
+  p.viscosity = 0.8e-3;  // Pa·s
   return p;
 }
 

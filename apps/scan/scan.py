@@ -26,6 +26,10 @@ except ImportError:  # Python < 3.11
     tomllib = None
 
 PROG = "scan"
+# The model's version for member folders: a change of spread's physics defaults makes an earlier member's results
+# another model's (29: Table 1's c read as the membrane's shear viscosity). member.json records it; a folder of
+# another version runs again.
+PHYSICS = 29
 # Whether spread was built for a GPU (a Kokkos with CUDA, HIP or SYCL): apps/scan/CMakeLists.txt sets it when
 # it copies this file into the build. The environment variable DCM_SCAN_DEVICE_BUILD (0 or 1) overrides it.
 DEVICE_BUILD = False  # set by the build
@@ -227,7 +231,8 @@ def load_scan(path):
             label = ", ".join(f"{k}={v:.4g}" for k, v in swept.items())
         else:
             label = ", ".join(f"{k}={fmt(v)}" for k, v in swept.items()) or "base"
-        out.append({"id": f"m{i:03d}", "label": label, "swept": swept, "sets": sets, "base_sha256": base_sha256})
+        out.append({"id": f"m{i:03d}", "label": label, "swept": swept, "sets": sets, "base_sha256": base_sha256,
+                    "physics": PHYSICS})
     return {"name": name, "base": base, "mode": mode, "sweep_keys": list(values), "members": out}
 
 
@@ -242,8 +247,10 @@ def spread_cmd(spread, scan, member, out_dir=None, extra=()):
 
 def same_member(stored, member):
     """True when a member.json's content describes `member`: the same --set values on a base scene of the same
-    content (a member folder of another base, or of the base before an edit, holds another run)."""
-    return stored.get("sets") == member["sets"] and stored.get("base_sha256") == member["base_sha256"]
+    content, run by the same model version (a member folder of another base, of the base before an edit or of an
+    earlier dcm whose defaults differ holds another run)."""
+    return (stored.get("sets") == member["sets"] and stored.get("base_sha256") == member["base_sha256"]
+            and stored.get("physics") == member["physics"])
 
 
 def member_state(mdir, member):
@@ -610,8 +617,8 @@ def main():
             changed = [m["id"] for m in queue if os.path.isfile(os.path.join(out, "members", m["id"], "member.json"))
                        and not results_of(os.path.join(out, "members", m["id"]), m)]
             if changed:
-                print(f"{PROG}: {len(changed)} member folder(s) hold a run of other settings or another base scene (the "
-                      f"scan file or its base changed): "
+                print(f"{PROG}: {len(changed)} member folder(s) hold a run of other settings, another base scene or an "
+                      f"earlier dcm (the scan file, its base or the model's defaults changed): "
                       f"run again: {' '.join(changed[:10])}{' ...' if len(changed) > 10 else ''}", flush=True)
             ids = {m["id"] for m in members}
             extra = sorted(d for d in os.listdir(os.path.join(out, "members")) if d not in ids)
