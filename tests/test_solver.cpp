@@ -445,7 +445,9 @@ TEST(FrictionOperator, BondDashpotsOfASurfaceViscosityDissipateAsTheMembrane) {
         EXPECT_NEAR(ratio, 1.0, 0.02)
             << "level " << level << (relative ? ", relative" : ", axial") << ", D =\n"
             << D;
-        if (!relative) EXPECT_LT(ratio * eta / c_b, 0.5) << "c_b = η per bond would be as viscous";
+        if (!relative) {
+          EXPECT_LT(ratio * eta / c_b, 0.5) << "c_b = η per bond would be as viscous";
+        }
       }
     }
   }
