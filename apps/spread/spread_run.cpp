@@ -73,6 +73,13 @@ void restore_from_checkpoint(Member& m, Model& model, Stepper& stepper) {
   if (c.arrays.count("app.pending_row")) m.pending_row = c.array("app.pending_row");  // since session 28
   if (c.arrays.count("app.h_last")) m.h_last = c.scalar("app.h_last");
   m.frames_before = static_cast<int>(c.scalar("app.frames"));
+  // A restart may ask for denser rows or frames (output.series_per_decade, output.frame_every_s): the next
+  // row and frame then come when the new cadence asks from here, not at the stored times the old cadence
+  // set. With the settings unchanged both stored times are already the earlier, so the run continues bit
+  // for bit.
+  const double t = stepper.time(m.cell);
+  m.p.next_sample = std::min(m.p.next_sample, t * std::pow(10.0, 1.0 / m.per_decade));
+  m.p.next_frame = std::min(m.p.next_frame, t + m.frame_every);
 }
 
 // spread.h5 (new, or resumed after the restart's frames) and series.csv.part with the rows so far.
