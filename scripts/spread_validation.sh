@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # The spreading runs behind docs/VALIDATION.md ("Spreading"): the paper scenes, the 642-node Hategan case
-# for the mesh comparison, one run per direction of the paper's Figure 5 and two with the contact-line law, in
-# two queues of one thread each (2 cores). Output: out/validation/<run>/ (each a spread output folder) and
+# for the mesh comparison and one run per direction of the paper's Figure 5, with the paper's model and with
+# dcm's contact-line setting, in two queues of one thread each (2 cores). Output: out/validation/<run>/ (each a spread output folder) and
 # out/validation/report.md (scripts/spread_report.py: each claim of the paper, measured, and whether it holds;
 # with QUEUE 1 or 2 the other queue's folders, possibly of older code, are judged too).
 # Takes about 20 minutes on 2 cores (session 16: 20.4 min; session 27: see docs/VALIDATION.md).
 # (The full paper scenes: build/bin/spread scenes/<scene>.toml.)
-#   bash scripts/spread_validation.sh [QUEUE]    # QUEUE = 1, 2 or both (default)
+#   bash scripts/spread_validation.sh [QUEUE]    # QUEUE = 1, 2, both (default) or cl (the contact-line runs only)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 builddir=$(bash scripts/build.sh release spread | tail -n 1)
@@ -38,15 +38,35 @@ queue2() {
   run fig5_k_b_x2 "${fig5[@]}" --set cortex.k_b_J=480e-21
   run fig5_x_max_2.5 "${fig5[@]}" --set cortex.x_max=2.5
   run fig5_k_a_2e-3 "${fig5[@]}" --set cortex.k_a=2e-3
-  # dcm's contact-line law (docs/VALIDATION.md, "Spreading, session 13"): 10242 nodes, ~2 min.
-  run hategan2004_contact_line scenes/hategan2004_contact_line.toml
-  run cuvelier2007_derjaguin scenes/cuvelier2007.toml --set time.adaptive=true --set contact.law=derjaguin --early-window-s 2,20
+}
+# dcm's contact-line setting (scenes/hategan2004_contact_line.toml: the Derjaguin law, k_a = k_d = 2e-4 N/m,
+# adaptive steps; docs/VALIDATION.md, "Spreading, session 30"): the same claims, each run 4-35 s on one thread.
+queue_cl() {
+  local cl=(scenes/hategan2004_contact_line.toml)
+  local cl_cuvelier=(scenes/cuvelier2007.toml --set time.adaptive=true --set contact.law=derjaguin
+    --set cortex.k_a=2e-4 --set cortex.k_d=2e-4 --early-window-s 2,20)
+  case "$1" in
+    1)
+      run cl_hategan2004_sphered "${cl[@]}"
+      run cl_hategan2004_sphered_642 "${cl[@]}" --set mesh.nodes=642
+      run cl_hategan2004_biconcave_642 "${cl[@]}" --set mesh.nodes=642 --set mesh.shape=evans_fung
+      run cl_cuvelier2007 "${cl_cuvelier[@]}"
+      ;;
+    2)
+      run cl_fig5_W_x2 "${cl[@]}" --set contact.W_J_per_m2=2e-3
+      run cl_fig5_gamma_n_half "${cl[@]}" --set contact.gamma_n_N_s_per_m3=4e9
+      run cl_fig5_k_b_x2 "${cl[@]}" --set cortex.k_b_J=480e-21
+      run cl_fig5_x_max_2.5 "${cl[@]}" --set cortex.x_max=2.5
+      run cl_fig5_k_a_third "${cl[@]}" --set cortex.k_a=6.67e-5
+      ;;
+  esac
 }
 case "${1:-both}" in
-  1) queue1 ;;
-  2) queue2 ;;
-  both) queue1 & queue2 & wait ;;
-  *) echo "usage: $0 [1|2|both]" >&2; exit 2 ;;
+  1) queue1; queue_cl 1 ;;
+  2) queue2; queue_cl 2 ;;
+  cl) queue_cl 1 & queue_cl 2 & wait ;;
+  both) { queue1; queue_cl 1; } & { queue2; queue_cl 2; } & wait ;;
+  *) echo "usage: $0 [1|2|cl|both]" >&2; exit 2 ;;
 esac
 # The paper's claims against these runs (docs/VALIDATION.md "Status at a glance" holds the same rows).
 py=$(command -v /usr/bin/python3 || command -v python3)  # Debian's, with h5py and numpy (scripts/deps.sh)
