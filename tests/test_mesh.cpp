@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 #include <stdexcept>
+#include <vector>
 
 #include "apps/common/stretch_setup.hpp"
 #include "core/host_mesh.hpp"
@@ -97,6 +98,36 @@ TEST(Topology, HingesAreTheTwoTrianglesOfEachEdge) {
     EXPECT_TRUE(oriented.count({h[1], h[0], h[3]})) << "(j, i, l) is a mesh triangle";
     EXPECT_NE(h[2], h[3]);
   }
+}
+
+// The hinges (and edges) are stored in the order of their lowest node of all four (session 30): a node gather
+// then meets every hinge first in storage order. Checked as that invariant and as its consequence: walking the
+// nodes in order, the first touch of each hinge never goes back in storage.
+TEST(Topology, HingesAreStoredInTheOrderTheNodeGathersFirstMeetThem) {
+  const HostMesh m = make_icosphere(4, 1.0);
+  const Topology t = build_topology(m);
+  const auto lowest = [&](int e) {
+    const auto& h = t.hinges[e];
+    return std::min({h[0], h[1], h[2], h[3]});
+  };
+  for (std::size_t e = 1; e < t.hinges.size(); ++e)
+    ASSERT_LE(lowest(static_cast<int>(e) - 1), lowest(static_cast<int>(e))) << "hinge " << e;
+  for (std::size_t e = 0; e < t.hinges.size(); ++e) {
+    EXPECT_EQ(t.edges[e][0], t.hinges[e][0]) << "edge " << e << " and its hinge share the storage index";
+    EXPECT_EQ(t.edges[e][1], t.hinges[e][1]);
+  }
+  std::vector<char> seen(t.hinges.size(), 0);
+  int last_first_touch = -1;
+  const int n = static_cast<int>(m.nodes.size());
+  for (int i = 0; i < n; ++i)
+    for (int k = t.node_hinge_offsets[i]; k < t.node_hinge_offsets[i + 1]; ++k) {
+      const int h = t.node_hinge_roles[k] >> 2;
+      if (seen[h]) continue;
+      seen[h] = 1;
+      EXPECT_GT(h, last_first_touch) << "node " << i << " meets hinge " << h << " first, after hinge "
+                                     << last_first_touch;
+      last_first_touch = h;
+    }
 }
 
 TEST(Topology, RingsAreOrderedCounterClockwiseFromOutside) {
