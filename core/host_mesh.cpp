@@ -68,8 +68,8 @@ void subdivide(HostMesh& m) {
 // of threads): on two threads whose cores share no cache, what one thread reads of the other's share is few
 // cache lines and they are consecutive, so the hardware fetches them ahead. The bands cross the x axis, so an
 // even split of a cell spread on a plane z = const divides its contact patch between the threads. The
-// triangle and edge kernels follow the same bands (edges are sorted by their lowest node, build_topology). docs/PERFORMANCE.md,
-// "Session 24", has the measurements (against the first-use numbering of session 22).
+// triangle and edge kernels follow the same bands (edges are sorted by their lowest node, build_topology).
+// docs/PERFORMANCE.md, "Session 24", has the measurements (against the first-use numbering of session 22).
 void renumber_in_bands(HostMesh& m) {
   const int n = static_cast<int>(m.nodes.size());
   std::vector<std::vector<int>> adjacent(n);

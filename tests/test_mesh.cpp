@@ -101,8 +101,8 @@ TEST(Topology, HingesAreTheTwoTrianglesOfEachEdge) {
 }
 
 // The hinges (and edges) are stored in the order of their lowest node of all four (session 30): a node gather
-// then meets every hinge first in storage order. Checked as that invariant and as its consequence: walking the
-// nodes in order, the first touch of each hinge never goes back in storage.
+// then meets every hinge first in storage order. Checked as that invariant and as its consequence: walking
+// the nodes in order, the first touch of each hinge never goes back in storage.
 TEST(Topology, HingesAreStoredInTheOrderTheNodeGathersFirstMeetThem) {
   const HostMesh m = make_icosphere(4, 1.0);
   const Topology t = build_topology(m);
