@@ -75,11 +75,15 @@ void restore_from_checkpoint(Member& m, Model& model, Stepper& stepper) {
   m.frames_before = static_cast<int>(c.scalar("app.frames"));
   // A restart may ask for denser rows or frames (output.series_per_decade, output.frame_every_s): the next
   // row and frame then come when the new cadence asks from here, not at the stored times the old cadence
-  // set. With the settings unchanged both stored times are already the earlier, so the run continues bit
-  // for bit.
+  // set. Only when that setting changed: a checkpoint taken with a row pending stores the next sample time
+  // of the pending step's end, which a clamp from the stepper's time would move (a row more than the run
+  // alone writes), so with the settings unchanged the stored times stay and the run continues bit for bit.
+  const Scene saved_scene = Scene::from_string(c.text("scene"), "checkpoint");
   const double t = stepper.time(m.cell);
-  m.p.next_sample = std::min(m.p.next_sample, t * std::pow(10.0, 1.0 / m.per_decade));
-  m.p.next_frame = std::min(m.p.next_frame, t + m.frame_every);
+  if (static_cast<double>(saved_scene.get_int("output.series_per_decade")) != m.per_decade)
+    m.p.next_sample = std::min(m.p.next_sample, t * std::pow(10.0, 1.0 / m.per_decade));
+  if (saved_scene.get_real("output.frame_every_s") != m.frame_every)
+    m.p.next_frame = std::min(m.p.next_frame, t + m.frame_every);
 }
 
 // spread.h5 (new, or resumed after the restart's frames) and series.csv.part with the rows so far.
