@@ -100,3 +100,29 @@ TEST(SpreadFits, ExponentOfAPowerLawInsideTheWindow) {
   EXPECT_TRUE(std::isnan(dcm::spread_fits::fit_exponent(same_t, some_r, 0.01, 0.1, used)));  // one time
   EXPECT_EQ(used, 4);
 }
+
+// The final growth: a power law still spreading at the end gives 1 − 0.9^α to within the interpolation
+// between rows (rows log-spaced as spread writes them, the window's start between two rows); a saturated
+// relaxation r = r_∞ (1 − e^(−t/τ)) gives e^(−0.9 T/τ) (1 − e^(−0.1 T/τ)) / (1 − e^(−T/τ)) to within the
+// linear interpolation between rows 6% apart; no row before the window's start, or no contact at the end,
+// gives NaN.
+TEST(SpreadFits, FinalGrowthOfSpreadingAndOfSaturatedCurves) {
+  std::vector<double> t, r_power, r_relax;
+  const double tau = 0.1, t_end = 1.2;
+  for (int i = 0; i <= 300; ++i) {
+    const double ti = std::min(t_end, 1e-5 * std::pow(10.0, i / 40.0));  // 40 rows per decade, then t_end
+    t.push_back(ti);
+    r_power.push_back(5e-6 * std::sqrt(ti));
+    r_relax.push_back(4.7e-6 * (1 - std::exp(-ti / tau)));
+    if (ti == t_end) break;
+  }
+  EXPECT_NEAR(dcm::spread_fits::final_growth(t, r_power, 0.9 * t_end), 1 - std::sqrt(0.9), 2e-4);
+  const double expected =
+      std::exp(-0.9 * t_end / tau) * (1 - std::exp(-0.1 * t_end / tau)) / (1 - std::exp(-t_end / tau));
+  EXPECT_NEAR(dcm::spread_fits::final_growth(t, r_relax, 0.9 * t_end), expected, 0.15 * expected);
+  EXPECT_LT(dcm::spread_fits::final_growth(t, r_relax, 0.9 * t_end), 1e-4);
+  EXPECT_TRUE(std::isnan(dcm::spread_fits::final_growth(t, r_power, 1e-6)));   // before the first row
+  EXPECT_TRUE(std::isnan(dcm::spread_fits::final_growth(t, r_power, t_end)));  // nothing after it
+  std::vector<double> no_contact(t.size(), 0.0);
+  EXPECT_TRUE(std::isnan(dcm::spread_fits::final_growth(t, no_contact, 0.9 * t_end)));
+}

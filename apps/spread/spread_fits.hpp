@@ -1,6 +1,7 @@
 #pragma once
-// The two fits of spread's summary.json (host only): the contact angle from a sphere fitted to the cell's
-// nodes, and the early exponent of r_cc(t). Tested on ideal caps and power laws (tests/test_spread_fits.cpp).
+// The fits of spread's summary.json (host only): the contact angle from a sphere fitted to the cell's nodes,
+// the early exponent of r_cc(t) and how much r_cc still grew at the end. Tested on ideal caps, power laws and
+// saturating curves (tests/test_spread_fits.cpp).
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -66,6 +67,21 @@ inline double fit_exponent(const std::vector<double>& t, const std::vector<doubl
   const double spread = used * sxx - sx * sx;  // 0 (up to rounding) when every row has the same t
   if (used < 3 || !(spread > 1e-12 * used * sxx)) return NAN;
   return (used * sxy - sx * sy) / spread;
+}
+
+// How much r_cc still grew at the end of a run: (r_last − r(from)) / r_last, r(from) interpolated linearly
+// between the rows around t = from (spread: from = 0.9 t_end, the last tenth of the run). NaN when no row
+// lies at or before from, none after it, or r_last is not positive. A run whose r_cc saturated gives ~0; a
+// run stopped while the cell still spreads as t^α gives 1 − 0.9^α (0.051 for α = 1/2).
+inline double final_growth(const std::vector<double>& t, const std::vector<double>& r, double from) {
+  const std::size_t n = std::min(t.size(), r.size());
+  if (n < 2 || !(r[n - 1] > 0) || !(t[n - 1] > from)) return NAN;
+  std::size_t k = n - 1;  // the last row at or before from
+  while (k > 0 && t[k] > from) --k;
+  if (t[k] > from) return NAN;
+  const double w = t[k + 1] > t[k] ? (from - t[k]) / (t[k + 1] - t[k]) : 1.0;
+  const double r_from = r[k] + w * (r[k + 1] - r[k]);
+  return (r[n - 1] - r_from) / r[n - 1];
 }
 
 }  // namespace dcm::spread_fits

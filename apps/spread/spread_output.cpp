@@ -126,6 +126,8 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   int used = 0;
   const SpreadOptions& so = m.so;
   const double alpha = fit_exponent(m.ts, m.rs, so.early_from_s, so.early_to_s, used);
+  // Whether the cell still spreads at the end: r_cc's growth over the last tenth of the simulated time.
+  const double growth = final_growth(m.ts, m.rs, 0.9 * t);
   const double wall = m.p.wall_before + wall_now;
   const Progress& p = m.p;
   // A run that ends but did not resolve its dynamics says so (stderr, also with --quiet, and summary.json's
@@ -175,6 +177,7 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
       .add("early_exponent", alpha)
       .add("early_window_s", std::vector<double>{so.early_from_s, so.early_to_s})
       .add("early_window_rows", used)
+      .add("r_cc_growth_last_tenth", growth)
       .add("height_final_m", ztop - m.plane_z)
       .add("steps", done)
       .add("dt_s", m.dt)
@@ -210,6 +213,15 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
         "controlled by time.error_tol_m, the energy balance is not resolved at these steps: lower "
         "time.dt_max_s to resolve it\n",
         residual_rel, dt_max);
+  // A cell still spreading at the end (r_cc up by 1% or more over the last tenth of the run; one still on
+  // t^(1/2) gives 5%): its final values are not the spread-out cell's.
+  if (!m.options.quiet && growth >= 0.01)
+    std::printf(
+        "  note: r_cc grew %.1f%% over the last tenth of the run (t = %.3g-%.3g s): the cell is still "
+        "spreading, "
+        "the final values are not those of the spread-out cell; continue with spread --restart '%s' --set "
+        "time.t_end_s=%g\n",
+        100 * growth, 0.9 * t, t, m.checkpoint_path.c_str(), 2 * t);
   if (so.plot && !m.interrupted && !m.stopped_at_max_steps) {
     const std::string cmd = std::string(DCM_PYTHON3) + " '" + DCM_SOURCE_DIR + "/scripts/plot_spread.py' " +
                             (m.options.quiet ? "--quiet '" : "'") + m.out_dir + "'";

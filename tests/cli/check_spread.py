@@ -85,6 +85,20 @@ def main():
         fail(f"series.csv ends at t = {rows[-1]['t_s']} s, the run at t_end_s = {s['t_end_s']} s")
     if not interrupted and not math.isclose(float(rows[-1]["r_cc_m"]), s["r_cc_final_m"], rel_tol=1e-6):
         fail(f"summary.json r_cc_final_m = {s['r_cc_final_m']}, the last row {rows[-1]['r_cc_m']}")
+    # r_cc_growth_last_tenth: r_cc's growth over the last tenth of the run, from the rows (linear between the
+    # two around 0.9 t_end); null when no row lies at or before it.
+    t = [float(r["t_s"]) for r in rows]
+    rc = [float(r["r_cc_m"]) for r in rows]
+    start = 0.9 * t[-1]
+    before = [k for k in range(len(t)) if t[k] <= start]
+    if "r_cc_growth_last_tenth" not in s:
+        fail("summary.json has no key r_cc_growth_last_tenth")
+    if before and rc[-1] > 0:
+        k = before[-1]
+        r_start = rc[k] + (start - t[k]) / (t[k + 1] - t[k]) * (rc[k + 1] - rc[k])
+        expected = (rc[-1] - r_start) / rc[-1]
+        if s["r_cc_growth_last_tenth"] is None or abs(s["r_cc_growth_last_tenth"] - expected) > 1e-6:
+            fail(f"summary.json r_cc_growth_last_tenth = {s['r_cc_growth_last_tenth']}, the rows give {expected}")
     if s.get("interrupted") != interrupted:
         fail(f"summary.json interrupted = {s.get('interrupted')}, expected {interrupted}")
     if not interrupted and not s["energy_residual_relative"] < 0.05:
