@@ -19,6 +19,18 @@ run() {  # name, then the spread arguments
   echo "== $name: $*"
   OMP_NUM_THREADS=1 "$spread" "$@" --quiet --out "$out/$name" > "$out/$name.log" 2>&1 || echo "   $name failed: $(tail -n 1 "$out/$name.log")"
 }
+continue_to() {  # run, new name, t_end: a copy of the finished run continued by spread --restart
+  local from=$1 name=$2 t_end=$3
+  echo "== $name: $from continued to $t_end s"
+  rm -rf "${out:?}/$name"
+  if [ -f "$out/$from/checkpoint.h5" ]; then
+    cp -r "$out/$from" "$out/$name"
+    OMP_NUM_THREADS=1 "$spread" --restart "$out/$name/checkpoint.h5" --set time.t_end_s="$t_end" --quiet \
+      > "$out/$name.log" 2>&1 || echo "   $name failed: $(tail -n 1 "$out/$name.log")"
+  else
+    echo "   $name not run: $from has no checkpoint"
+  fi
+}
 # The fixed-step runs (the paper's Δt): ~4 min for 642 nodes and ~10 min for 2562 on one thread (session 27).
 # The Figure 5 runs use adaptive steps (tolerance 1e-9 m; its error is measured by perf/work_precision.py,
 # docs/PERFORMANCE.md), 7-40 s each.
@@ -33,6 +45,7 @@ queue2() {
   # scatter hid k_b's few per cent and the rings' quantisation gave k_a a 2% effect on the final radius).
   local fig5=(scenes/hategan2004_sphered.toml --set time.adaptive=true --set time.error_tol_m=1e-9)
   run fig5_reference "${fig5[@]}"
+  continue_to fig5_reference fig5_reference_to_2.4s 2.4  # at rest after ~1 s? (the paper: stopped at 0.9 s)
   run fig5_W_x2 "${fig5[@]}" --set contact.W_J_per_m2=2e-3
   run fig5_gamma_n_half "${fig5[@]}" --set contact.gamma_n_N_s_per_m3=4e9
   run fig5_k_b_x2 "${fig5[@]}" --set cortex.k_b_J=480e-21
@@ -48,6 +61,7 @@ queue_cl() {
   case "$1" in
     1)
       run cl_hategan2004_sphered "${cl[@]}"
+      continue_to cl_hategan2004_sphered cl_hategan2004_sphered_to_2.4s 2.4
       run cl_hategan2004_sphered_642 "${cl[@]}" --set mesh.nodes=642
       run cl_hategan2004_biconcave_642 "${cl[@]}" --set mesh.nodes=642 --set mesh.shape=evans_fung
       run cl_cuvelier2007 "${cl_cuvelier[@]}"
