@@ -126,8 +126,10 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   int used = 0;
   const SpreadOptions& so = m.so;
   const double alpha = fit_exponent(m.ts, m.rs, so.early_from_s, so.early_to_s, used);
-  // Whether the cell still spreads at the end: r_cc's growth over the last tenth of the simulated time.
-  const double growth = final_growth(m.ts, m.rs, 0.9 * t);
+  // Whether the cell still spreads at the end: r_cc's growth over the last tenth of the series (its last row
+  // is the end state's, except in a run stopped between rows).
+  const double t_rows = m.ts.empty() ? t : m.ts.back();
+  const double growth = final_growth(m.ts, m.rs, 0.9 * t_rows);
   const double wall = m.p.wall_before + wall_now;
   const Progress& p = m.p;
   // A run that ends but did not resolve its dynamics says so (stderr, also with --quiet, and summary.json's
@@ -221,7 +223,7 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
         "spreading, "
         "the final values are not those of the spread-out cell; continue with spread --restart '%s' --set "
         "time.t_end_s=%g\n",
-        100 * growth, 0.9 * t, t, m.checkpoint_path.c_str(), 2 * t);
+        100 * growth, 0.9 * t_rows, t_rows, m.checkpoint_path.c_str(), 2 * t);
   if (so.plot && !m.interrupted && !m.stopped_at_max_steps) {
     const std::string cmd = std::string(DCM_PYTHON3) + " '" + DCM_SOURCE_DIR + "/scripts/plot_spread.py' " +
                             (m.options.quiet ? "--quiet '" : "'") + m.out_dir + "'";
