@@ -19,7 +19,8 @@ The thresholds a row applies are printed in its "target" column; where the paper
 65° ± 10°) that band is used, where it gives a direction ("faster", "wider") a change of 0.5% or more that
 way (the Figure 5 runs are adaptive 2562-node runs since session 27, whose r_cc moves by less than 0.01%
 when the CG tolerance changes by 1%; 642-node runs scatter by several per cent in the touch-down,
-docs/PERFORMANCE.md).
+docs/PERFORMANCE.md). "Faster" is judged on the mean difference over the early regime, 0.01–0.1 s (since
+session 31; before, r_cc at 0.01 s alone, which scatters by 0.2% with the step tolerance).
 """
 import csv
 import json
@@ -114,6 +115,19 @@ def max_relative_difference(a, b, t_from, t_to):
                 d = abs(ri - rb) / rb
                 worst = d if worst is None else max(worst, d)
     return worst
+
+
+def mean_relative_difference(a, b, t_from, t_to):
+    """Mean of r_a / r_b − 1 over the rows of b with t_from ≤ t ≤ t_to (a interpolated); None without rows.
+    The Figure 5 "faster" rows use it over the early regime, 0.01–0.1 s: r_cc at a single early time scatters
+    with the step tolerance by as much as k_b's effect there (docs/VALIDATION.md, "Spreading, session 31")."""
+    d = []
+    for ti, rb in zip(*b):
+        if t_from <= ti <= t_to and rb > 0:
+            ra = r_at(a, ti)
+            if ra is not None:
+                d.append(ra / rb - 1)
+    return sum(d) / len(d) if d else None
 
 
 def um(value):
@@ -261,17 +275,19 @@ def judge(folder, setting):
     def direction(run, what, faster, wider, no_effect=False):
         claim = f"Figure 5: {what}"
         target = ("no effect: final r_cc within 2%" if no_effect else
-                  " and ".join(x for x in ("faster: r_cc at 0.01 s larger by 0.5% or more" if faster else "",
+                  " and ".join(x for x in ("faster: r_cc larger by 0.5% or more over 0.01–0.1 s (mean)" if faster
+                                           else "",
                                            "wider: final r_cc larger by 0.5% or more" if wider else "") if x))
         if missing(claim, target, run, "fig5_reference"):
             return
         ref, var = runs["fig5_reference"], runs[run]
         r0, r1 = r_at(ref[1], 0.01), r_at(var[1], 0.01)
         f0, f1 = ref[0].get("r_cc_final_m"), var[0].get("r_cc_final_m")
-        early = None if not r0 or r1 is None else r1 / r0 - 1
+        at_10ms = None if not r0 or r1 is None else r1 / r0 - 1
+        early = mean_relative_difference(var[1], ref[1], 0.01, 0.1)
         final = None if not f0 or f1 is None else f1 / f0 - 1
-        measured = (f"r_cc at 0.01 s {fmt(pct(early), '+.2f', '%')}, "
-                    f"final {fmt(pct(final), '+.2f', '%')}")
+        measured = (f"r_cc over 0.01–0.1 s {fmt(pct(early), '+.2f', '%')} "
+                    f"(at 0.01 s {fmt(pct(at_10ms), '+.2f', '%')}), final {fmt(pct(final), '+.2f', '%')}")
         if no_effect:
             ok = None if final is None else abs(final) <= 0.02
         else:
