@@ -219,11 +219,11 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   // t^(1/2) gives 5%): its final values are not the spread-out cell's.
   if (!m.options.quiet && growth >= 0.01)
     std::printf(
-        "  note: r_cc grew %.1f%% over the last tenth of the run (t = %.3g-%.3g s): the cell is still "
-        "spreading, "
-        "the final values are not those of the spread-out cell; continue with spread --restart '%s' --set "
-        "time.t_end_s=%g\n",
-        100 * growth, 0.9 * t_rows, t_rows, m.checkpoint_path.c_str(), 2 * t);
+        "  %snote: r_cc grew %.1f%% over the last tenth of the run (t = %.3g-%.3g s): the cell is still "
+        "spreading, the final values are not those of the spread-out cell; continue with spread --restart "
+        "'%s' --set time.t_end_s=%g\n",
+        m.cell > 0 || !m.so.batch.empty() ? (m.out_dir + ": ").c_str() : "", 100 * growth, 0.9 * t_rows,
+        t_rows, m.checkpoint_path.c_str(), 2 * t);
   if (so.plot && !m.interrupted && !m.stopped_at_max_steps) {
     const std::string cmd = std::string(DCM_PYTHON3) + " '" + DCM_SOURCE_DIR + "/scripts/plot_spread.py' " +
                             (m.options.quiet ? "--quiet '" : "'") + m.out_dir + "'";
