@@ -2,6 +2,7 @@
 // with a flat base (the contact angle) and exact power laws (the early exponent).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -125,4 +126,37 @@ TEST(SpreadFits, FinalGrowthOfSpreadingAndOfSaturatedCurves) {
   EXPECT_TRUE(std::isnan(dcm::spread_fits::final_growth(t, r_power, t_end)));  // nothing after it
   std::vector<double> no_contact(t.size(), 0.0);
   EXPECT_TRUE(std::isnan(dcm::spread_fits::final_growth(t, no_contact, 0.9 * t_end)));
+}
+
+// The nodes in range of the plane over the rows: the first row with the most of them marks where r_cc's
+// growth by stretching is measured from (a later row with as many, or fewer, does not move it).
+TEST(SpreadFits, ContactNodesKeepTheFirstRowWithTheMost) {
+  dcm::spread_fits::ContactNodes c;
+  EXPECT_TRUE(std::isnan(c.growth_since(4e-6)));  // no row yet
+  c.add_row(0, 1e-5, 0.0);                        // not touching: no contact to grow from
+  EXPECT_TRUE(std::isnan(c.growth_since(4e-6)));
+  c.add_row(7, 1e-3, 0.5e-6);
+  c.add_row(40, 0.3, 4.0e-6);
+  c.add_row(40, 0.6, 4.2e-6);  // as many: the contact grew inside the bound membrane
+  c.add_row(39, 0.9, 4.3e-6);  // one node left the range
+  EXPECT_EQ(c.most, 40.0);
+  EXPECT_EQ(c.t, 0.3);
+  EXPECT_NEAR(c.growth_since(4.35e-6), 0.35e-6, 1e-18);
+  EXPECT_TRUE(c.grew_by_stretching(4.35e-6, 0.25e-6));   // past more than an edge
+  EXPECT_FALSE(c.grew_by_stretching(4.35e-6, 0.49e-6));  // within the last ring's triangles
+  c.add_row(41, 1.0, 4.4e-6);                            // one more node came down: growth counts from here
+  EXPECT_NEAR(c.growth_since(4.45e-6), 0.05e-6, 1e-18);
+  EXPECT_FALSE(c.grew_by_stretching(4.45e-6, 0.25e-6));
+  dcm::spread_fits::ContactNodes unknown{NAN, NAN, NAN};  // continued from a checkpoint without the count
+  unknown.add_row(50, 1.1, 4.5e-6);
+  EXPECT_TRUE(std::isnan(unknown.growth_since(5e-6)));
+  EXPECT_FALSE(unknown.grew_by_stretching(5e-6, 1e-9));
+}
+
+TEST(SpreadFits, MeanEdgeOfATetrahedron) {
+  // A regular tetrahedron of edge √8: every edge counted twice, the mean is the edge.
+  const std::vector<std::array<double, 3>> x = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
+  const std::vector<std::array<int, 3>> tri = {{0, 1, 2}, {0, 3, 1}, {0, 2, 3}, {1, 3, 2}};
+  EXPECT_NEAR(dcm::spread_fits::mean_edge_length(x, tri), std::sqrt(8.0), 1e-15);
+  EXPECT_TRUE(std::isnan(dcm::spread_fits::mean_edge_length(x, {})));
 }

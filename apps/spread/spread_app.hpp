@@ -104,16 +104,19 @@ struct Member {
   MechanicsParams params;
   TimeStepSettings steps;
   CgSettings cg;
-  double plane_z = 0, dt = 0, t_end = 0, frame_every = 0, per_decade = 0, checkpoint_every = 0;
+  double plane_z = 0, h0 = 0, edge_mean = 0, dt = 0, t_end = 0, frame_every = 0, per_decade = 0,
+         checkpoint_every = 0;
   std::string out_dir, checkpoint_path, csv_tmp;
   int cell = 0, first_node = 0, n = 0;
   Progress p;
   std::vector<double> ts, rs, areas_c, heights;  // series columns the summary's fits use
   std::vector<double> series_rows;               // every series row (kSeriesColumns values each), for HDF5
+  spread_fits::ContactNodes contact_nodes;       // over the series rows (summary.json, the binding note)
   std::string csv_text = series_header();
-  // The row of the last sampled step (kSeriesColumns values, then the step's start energy), written once the
-  // next step has accepted that step: an adaptive step may take the one before it again, shorter
-  // (solvers/time_stepper.hpp), and the row then describes the state that step reaches instead.
+  // The row of the last sampled step (kSeriesColumns values, then the step's start energy and the nodes
+  // within h0 of the plane), written once the next step has accepted that step: an adaptive step may take the
+  // one before it again, shorter (solvers/time_stepper.hpp), and the row then describes the state that step
+  // reaches instead.
   std::vector<double> pending_row;
   double h_last = 0;  // the last step's length, into dt_min/max_taken_s once the next step accepts it
   int frames_before = 0;

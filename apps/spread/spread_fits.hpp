@@ -4,6 +4,7 @@
 // saturating curves (tests/test_spread_fits.cpp).
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <vector>
@@ -82,6 +83,45 @@ inline double final_growth(const std::vector<double>& t, const std::vector<doubl
   const double w = t[k + 1] > t[k] ? (from - t[k]) / (t[k + 1] - t[k]) : 1.0;
   const double r_from = r[k] + w * (r[k + 1] - r[k]);
   return (r[n - 1] - r_from) / r[n - 1];
+}
+
+// The nodes in range of the plane over a run's series rows (within contact.h0_m of it): the most of them a
+// row has seen, and the time and r_cc of the first row that saw that many. most = NaN: not known (a run
+// continued from a checkpoint of a dcm before session 32).
+struct ContactNodes {
+  double most = -1, t = NAN, r = NAN;
+  void add_row(double nodes, double t_row, double r_row) {
+    if (nodes > most) {
+      most = nodes;
+      t = t_row;
+      r = r_row;
+    }
+  }
+  // r_final − r_cc of the first row with the most nodes (m); NaN when not known or without contact then.
+  double growth_since(double r_final) const {
+    if (!(most > 0) || !(r > 0) || !(r_final > 0)) return NAN;
+    return r_final - r;
+  }
+  // Whether the contact radius moved outward by more than a mesh edge while no more nodes came into range:
+  // the contact front then moved past a node ring without binding it, which only in-plane stretching of the
+  // membrane already bound does (docs/model/contact_line.md, "The line held at a node ring"). Growth within
+  // the triangles of the last ring (the paper's law at rest, a coarse mesh) stays below an edge.
+  bool grew_by_stretching(double r_final, double edge_m) const { return growth_since(r_final) > edge_m; }
+};
+
+// The mean edge length of a triangle mesh (each edge counted once per triangle: on a closed mesh every edge
+// twice, so the mean of the edges).
+inline double mean_edge_length(const std::vector<std::array<double, 3>>& x,
+                               const std::vector<std::array<int, 3>>& tri) {
+  double sum = 0;
+  for (const auto& t : tri)
+    for (int k = 0; k < 3; ++k) {
+      const auto& a = x[t[k]];
+      const auto& b = x[t[(k + 1) % 3]];
+      sum += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                       (a[2] - b[2]) * (a[2] - b[2]));
+    }
+  return tri.empty() ? NAN : sum / (3.0 * static_cast<double>(tri.size()));
 }
 
 }  // namespace dcm::spread_fits

@@ -173,10 +173,12 @@ void prepare_member(Member& m) {
   m.per_decade = static_cast<double>(scene.get_int("output.series_per_decade"));
   m.checkpoint_every = scene.get_real("output.checkpoint_every_s");
   m.plane_z = scene.get_real("contact.plane_z_m");
+  m.h0 = scene.get_real("contact.h0_m");
   m.mesh = cell_mesh_from_scene(scene);
   double zmin = INFINITY;
   for (const auto& x : m.mesh.nodes) zmin = std::min(zmin, x[2]);
   for (auto& x : m.mesh.nodes) x[2] += m.plane_z + gap - zmin;
+  m.edge_mean = spread_fits::mean_edge_length(m.mesh.nodes, m.mesh.triangles);
   m.params = mechanics_from_scene(scene);
 }
 

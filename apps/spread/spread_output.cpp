@@ -35,6 +35,8 @@ void commit_row(Member& m) {
   m.areas_c.push_back(row[2]);
   m.heights.push_back(row[7]);
   m.series_rows.insert(m.series_rows.end(), row.begin(), row.begin() + kSeriesColumns.size());
+  if (row.size() > kSeriesColumns.size() + 1)  // a row pending in a checkpoint before session 32 has no count
+    m.contact_nodes.add_row(row[kSeriesColumns.size() + 1], row[0], row[1]);
   append_h5_series(m, row.data());
   m.pending_row.clear();
 }
@@ -70,6 +72,7 @@ void write_checkpoint_now(Member& m, const Model& model, const Stepper& stepper,
   c.put_text("app.series_csv", m.csv_text);
   c.put("app.series_rows", m.series_rows);
   c.put("app.pending_row", m.pending_row);
+  c.put("app.contact_nodes", std::vector<double>{m.contact_nodes.most, m.contact_nodes.t, m.contact_nodes.r});
   c.put("app.h_last", m.h_last);
   c.put("app.early_window_s", std::vector<double>{m.so.early_from_s, m.so.early_to_s});
   c.put("app.frames", m.h5 ? static_cast<double>(m.h5->frames()) : 0.0);
@@ -121,7 +124,11 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   const long long done = static_cast<long long>(m.p.step);
   const auto x = model.cell_slice(model.positions(), m.cell);
   double ztop = -INFINITY;
-  for (int i = 0; i < m.n; ++i) ztop = std::max(ztop, x[3 * i + 2]);
+  int near_final = 0;  // nodes within h0 of the plane at the end
+  for (int i = 0; i < m.n; ++i) {
+    ztop = std::max(ztop, x[3 * i + 2]);
+    near_final += x[3 * i + 2] - m.plane_z < m.h0;
+  }
   const CapFit cap = fit_cap(x, m.plane_z, false), cap_free = fit_cap(x, m.plane_z, true);
   int used = 0;
   const SpreadOptions& so = m.so;
@@ -180,6 +187,11 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
       .add("early_window_s", std::vector<double>{so.early_from_s, so.early_to_s})
       .add("early_window_rows", used)
       .add("r_cc_growth_last_tenth", growth)
+      .add("contact_nodes_final", near_final)
+      .add("contact_nodes_most", m.contact_nodes.most)
+      .add("contact_nodes_most_from_s", m.contact_nodes.t)
+      .add("r_cc_growth_since_contact_nodes_most_m", m.contact_nodes.growth_since(r_final))
+      .add("mesh_edge_mean_m", m.edge_mean)
       .add("height_final_m", ztop - m.plane_z)
       .add("steps", done)
       .add("dt_s", m.dt)
@@ -224,6 +236,16 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
         "'%s' --set time.t_end_s=%g\n",
         m.cell > 0 || !m.so.batch.empty() ? (m.out_dir + ": ").c_str() : "", 100 * growth, 0.9 * t_rows,
         t_rows, m.checkpoint_path.c_str(), 2 * t);
+  // The contact front past a node ring that did not come down: the membrane already bound is being stretched
+  // outward (docs/model/contact_line.md, "The line held at a node ring").
+  if (!m.options.quiet && m.contact_nodes.grew_by_stretching(r_final, m.edge_mean))
+    std::printf(
+        "  %snote: r_cc grew %.3g um after the last node came within contact.h0_m of the plane (t = %.3g s, "
+        "%.0f nodes), more than the mesh's mean edge (%.3g um): the contact grows by stretching the membrane "
+        "already bound, not by binding more of it (docs/model/contact_line.md)\n",
+        m.cell > 0 || !m.so.batch.empty() ? (m.out_dir + ": ").c_str() : "",
+        m.contact_nodes.growth_since(r_final) * 1e6, m.contact_nodes.t, m.contact_nodes.most,
+        m.edge_mean * 1e6);
   if (so.plot && !m.interrupted && !m.stopped_at_max_steps) {
     const std::string cmd = std::string(DCM_PYTHON3) + " '" + DCM_SOURCE_DIR + "/scripts/plot_spread.py' " +
                             (m.options.quiet ? "--quiet '" : "'") + m.out_dir + "'";

@@ -71,6 +71,12 @@ void restore_from_checkpoint(Member& m, Model& model, Stepper& stepper) {
     }
   }
   if (c.arrays.count("app.pending_row")) m.pending_row = c.array("app.pending_row");  // since session 28
+  if (c.arrays.count("app.contact_nodes")) {                                          // since session 32
+    const std::vector<double>& n = c.array("app.contact_nodes", 3);
+    m.contact_nodes = {n[0], n[1], n[2]};
+  } else {
+    m.contact_nodes.most = NAN;  // not known: the rows before the restart did not count them
+  }
   if (c.arrays.count("app.h_last")) m.h_last = c.scalar("app.h_last");
   m.frames_before = static_cast<int>(c.scalar("app.frames"));
   // A restart may ask for denser rows or frames (output.series_per_decade, output.frame_every_s): the next
@@ -175,13 +181,18 @@ struct AfterStep {
 
 // A series row of member m for its step from t, h long, ending in the state `after` holds, with the step's
 // energy balance: (E(t+h) − E(t))/h against the contact power minus the dissipation, both at the step's
-// start with its velocity. Then the step's start energy (the row's 15th value, for a redo).
+// start with its velocity. Then the step's start energy (the row's 15th value, for a redo) and the number of
+// nodes within h0 of the plane (16th).
 std::vector<double> make_row(const Member& m, double t, double h, int iterations, double e0, double pc,
                              double dis, const AfterStep& after) {
   const double e_after = after.energy[m.cell], de = (e_after - e0) / h;
   const double area_c = after.contact_area[m.cell];
   double ztop = -INFINITY;
-  for (int i = m.first_node; i < m.first_node + m.n; ++i) ztop = std::max(ztop, after.x[3 * i + 2]);
+  int near = 0;
+  for (int i = m.first_node; i < m.first_node + m.n; ++i) {
+    ztop = std::max(ztop, after.x[3 * i + 2]);
+    near += after.x[3 * i + 2] - m.plane_z < m.h0;
+  }
   std::vector<double> row = {t + h,
                              std::sqrt(area_c / kPi),
                              area_c,
@@ -196,7 +207,8 @@ std::vector<double> make_row(const Member& m, double t, double h, int iterations
                              pc,
                              dis,
                              de - (pc - dis),
-                             e0};
+                             e0,
+                             static_cast<double>(near)};
   return row;
 }
 
@@ -230,6 +242,9 @@ struct BeforeStep {
             make_row(m, t0, t_now - t0, static_cast<int>(old[5]), old[14], old[11], old[12], *now);
         row[0] = t_now;
         m.pending_row = row;
+        // The next sample time follows the row's own time, as record_row sets it (it had followed the end of
+        // the step taken again, so the next row came up to that step's length too late: session 32).
+        m.p.next_sample = t_now * std::pow(10.0, 1.0 / m.per_decade);
       }
       commit_row(m);
     }

@@ -61,7 +61,7 @@ def main():
     # before it ends (an adaptive step that takes the step before again, shorter, replaces that step's row).
     for a, b in zip(rows, rows[1:]):
         ta, tb, hb = float(a["t_s"]), float(b["t_s"]), float(b["dt_s"])
-        if not tb > ta or tb - hb < ta - 1e-5 * hb:  # dt_s has 6 digits
+        if not tb > ta or tb - hb < ta - 1e-5 * hb - 1e-8 * tb:  # dt_s has 6 digits, t_s 9
             fail(f"row at t = {tb} s (dt_s = {hb}) after the row at t = {ta} s")
     # Log-spaced rows (output.series_per_decade): after the first ten steps, the step of each row starts
     # before the next sample time of the row before it (the first step that reaches it writes the row; until
@@ -105,10 +105,38 @@ def main():
         fail(f"energy residual {s['energy_residual_relative']} of the powers")
     if s.get("warnings") != []:
         fail(f"summary.json warnings = {s.get('warnings')}, expected none")
+    # The nodes in range of the plane (session 32): the first row with the most of them is a row of the series,
+    # and r_cc's growth since is measured from it.
+    for k in ("contact_nodes_final", "contact_nodes_most", "contact_nodes_most_from_s",
+              "r_cc_growth_since_contact_nodes_most_m", "mesh_edge_mean_m"):
+        if k not in s:
+            fail(f"summary.json has no key {k}")
+    if s["contact_nodes_most"] is not None:
+        if s["contact_nodes_most"] < s["contact_nodes_final"]:
+            fail(f"contact_nodes_most {s['contact_nodes_most']} < contact_nodes_final {s['contact_nodes_final']}")
+        at = [k for k in range(len(t)) if math.isclose(t[k], s["contact_nodes_most_from_s"], rel_tol=1e-6)]
+        if not at:
+            fail(f"contact_nodes_most_from_s = {s['contact_nodes_most_from_s']} is not the time of a row")
+        if rc[at[0]] > 0 and not interrupted:
+            g = rc[-1] - rc[at[0]]
+            if not math.isclose(s["r_cc_growth_since_contact_nodes_most_m"], g, rel_tol=1e-5, abs_tol=1e-14):
+                fail(f"r_cc_growth_since_contact_nodes_most_m = {s['r_cc_growth_since_contact_nodes_most_m']}, "
+                     f"the rows give {g}")
     with h5py.File(os.path.join(out, "spread.h5"), "r") as h5:
         # A run that reached its end reports the scene's t_end itself, not the rounded sum of its steps.
         text = h5.attrs["scene"]
         scene = tomllib.loads(text.decode() if isinstance(text, bytes) else text)
+        # contact_nodes_final: the nodes of the end state (the last frame) within contact.h0_m of the plane;
+        # mesh_edge_mean_m: the mean edge of the mesh as placed (/mesh).
+        x_end = h5["frames"][sorted(h5["frames"].keys())[-1]]["x"][:]
+        plane_z, h0 = float(scene["contact"]["plane_z_m"]), float(scene["contact"]["h0_m"])
+        near = int(sum(1 for p in x_end if p[2] - plane_z < h0))
+        if near != s["contact_nodes_final"]:
+            fail(f"summary.json contact_nodes_final = {s['contact_nodes_final']}, the last frame has {near}")
+        x0, tri = h5["mesh"]["x"][:], h5["mesh"]["triangles"][:]
+        edges = [math.dist(x0[a], x0[b]) for tr in tri for a, b in ((tr[0], tr[1]), (tr[1], tr[2]), (tr[2], tr[0]))]
+        if not math.isclose(sum(edges) / len(edges), s["mesh_edge_mean_m"], rel_tol=1e-9):
+            fail(f"mesh_edge_mean_m = {s['mesh_edge_mean_m']}, /mesh gives {sum(edges) / len(edges)}")
         t_end = float(scene["time"]["t_end_s"])
         if not interrupted and not s.get("stopped_at_max_steps") and not s.get("restarted_from") \
                 and s["t_end_s"] != t_end:
