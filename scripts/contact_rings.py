@@ -1,0 +1,59 @@
+#!/usr/bin/env python3
+"""How a spread run's contact grows: by more membrane coming down, or by the bound membrane stretching.
+
+For every frame of OUT/spread.h5 (or every K-th with --every K) it prints the time, the nodes within contact.h0_m
+of the plane ("in range"), the radius of the outermost of them about their centre, the largest and the mean
+node stretch among them (the frames' `stretch`: mean d/d* of the node's bonds; x_max is the FENE limit) and the
+mean stretch of the other nodes. A contact radius that grows while the count stays the same is the bound
+membrane being stretched outward (docs/model/contact_line.md, "The line held at a node ring"). The plane and
+h0 come from the scene stored in the file.
+
+  python3 scripts/contact_rings.py out/RUN [--every 4]
+"""
+import argparse
+import os
+import sys
+import tomllib
+
+os.environ.setdefault("HDF5_USE_FILE_LOCKING", "FALSE")
+import h5py  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("out", help="a spread output folder (holding spread.h5)")
+    ap.add_argument("--every", type=int, default=1, help="print every K-th frame (and the last); default 1")
+    a = ap.parse_args()
+    if a.every < 1:
+        sys.exit(f"contact_rings: --every = {a.every}, allowed: 1 or more")
+    path = os.path.join(a.out, "spread.h5")
+    try:
+        f = h5py.File(path, "r")
+    except OSError as e:
+        sys.exit(f"contact_rings: {path}: {e}")
+    with f:
+        text = f.attrs["scene"]
+        scene = tomllib.loads(text.decode() if isinstance(text, bytes) else text)
+        plane_z, h0 = float(scene["contact"]["plane_z_m"]), float(scene["contact"]["h0_m"])
+        names = sorted(f["frames"].keys())
+        if not names:
+            sys.exit(f"contact_rings: {path} has no frames")
+        picked = names[::a.every] + ([names[-1]] if (len(names) - 1) % a.every else [])
+        print("t_s,nodes_in_range,outer_radius_m,stretch_max_in_range,stretch_mean_in_range,stretch_mean_free")
+        for name in picked:
+            g = f["frames"][name]
+            x, s = g["x"][:], g["stretch"][:]
+            near = x[:, 2] - plane_z < h0
+            if near.any():
+                c = x[near, :2].mean(axis=0)
+                r = np.hypot(x[near, 0] - c[0], x[near, 1] - c[1]).max()
+                s_max, s_mean = s[near].max(), s[near].mean()
+            else:
+                r = s_max = s_mean = float("nan")
+            s_free = s[~near].mean() if (~near).any() else float("nan")
+            print(f"{g.attrs['time']:.6g},{int(near.sum())},{r:.6g},{s_max:.4f},{s_mean:.4f},{s_free:.4f}")
+
+
+if __name__ == "__main__":
+    main()
