@@ -218,9 +218,14 @@ def judge(folder, setting):
         r1 = r_at(series, 1.2)
         t2, r2 = (series[0][-1], series[1][-1]) if series[1] else (None, None)
         growth = None if not r1 or r2 is None else r2 / r1 - 1
+        # Since session 32 a run says when its last node came within h0 of the plane: growth after it is the
+        # bound membrane stretching (docs/model/contact_line.md, "The line held at a node ring").
+        since, t_last = s.get("r_cc_growth_since_contact_nodes_most_m"), s.get("contact_nodes_most_from_s")
+        how = "" if since is None or t_last is None else \
+            f"; last node down at {fmt(t_last, '.2f', ' s')}, r_cc {fmt(um(since), '+.3f', ' µm')} since"
         row(claim, target, f"r_cc {fmt(um(r1), '.3f')} µm at 1.2 s, {fmt(um(r2), '.3f', ' µm')} at "
             f"{fmt(t2, 'g', ' s')} ({fmt(pct(growth), '+.2f', '%')}; free fit "
-            f"{fmt(s.get('contact_angle_free_deg'), '.1f', '°')} there)",
+            f"{fmt(s.get('contact_angle_free_deg'), '.1f', '°')} there{how})",
             None if growth is None or t2 < 2.4 * (1 - 1e-9) else growth <= 0.01)
     claim, target = "Hategan sphered: final contact angle", "65° ± 10° (free fit)"
     if not missing(claim, target, name):
