@@ -4,7 +4,8 @@
     python3 scripts/plot_spread.py [--quiet] OUT_DIR
 
 r_cc.png    contact radius against time on log-log axes with a t^(1/2) guide and the fitted early slope
-            (paper Figure 4 style)
+            (paper Figure 4 style), and a dotted line where the last node came down when the contact grew by
+            more than a mesh edge after it (stretching of the bound membrane)
 cells.png   the cell at the frames nearest t = 0.1, 0.35, 0.9 s, coloured by the normal force per node
             (top) and the cortex tension of eq. 1 (bottom) (paper Figure 6 style); a run that ends before
             0.9 s shows the frames nearest the same fractions of its own end time, each frame once
@@ -62,6 +63,13 @@ def plot_rcc(out, s, summary):
             c = np.polyfit(np.log(t[m]), np.log(r[m] * 1e6), 1)
             ax.loglog(t[m], np.exp(np.polyval(c, np.log(t[m]))), "C3-", lw=2.5, alpha=0.6,
                       label=f"fit {w[0]:g}-{w[1]:g} s: slope {alpha:.2f}")
+    # Where the contact went on growing by stretching the bound membrane (spread's note; docs/model/contact_line.md,
+    # "The line held at a node ring"): a dotted line at the time the last node came within h0 of the plane.
+    since, t_last, edge = (summary.get(k) for k in ("r_cc_growth_since_contact_nodes_most_m",
+                                                    "contact_nodes_most_from_s", "mesh_edge_mean_m"))
+    if None not in (since, t_last, edge) and since > edge and t_last > 0:
+        ax.axvline(t_last, color="C2", ls=":", lw=1.2,
+                   label=f"last node down ({t_last:.2g} s); then +{since * 1e6:.2f} µm by stretching")
     ax.set_xlabel("t (s)")
     ax.set_ylabel(r"$r_{cc}$ (µm)")
     ax.set_title(f"{summary.get('scene', '')}: {summary.get('nodes', '')} nodes")
