@@ -100,6 +100,11 @@ std::vector<ParamSpec> make_schema() {
       real_key("cortex.k_s_N_per_m", "3.2e-6", 0, 1, kExcl, "N/m", "FENE+POW spring constant"),
       real_key("cortex.x_max", "2.05", 1, 10, kExcl, "", "maximum bond extension d_max/d*"),
       real_key(
+          "cortex.bond_prestretch", "1", 1, 10, kIncl, "",
+          "initial bond length over its rest length d*: 1 = the cell is given in its rest state (the paper); "
+          "> 1 = its network is under tension in the given shape, as a swollen cell's (dcm's extension, "
+          "docs/model/contact_line.md); must be below cortex.x_max"),
+      real_key(
           "cortex.c_N_s_per_m", "1.5e-6", 0, 1, kIncl, "N·s/m",
           "cortex damping c (Table 1): the membrane's in-plane shear viscosity (N·s/m = Pa·s·m), or each "
           "bond's dashpot coefficient, as cortex.c_reading says"),

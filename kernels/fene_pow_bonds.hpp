@@ -1,4 +1,5 @@
 #pragma once
+#include <vector>
 // In-plane elasticity of the cortex: FENE + POW per bond (paper eqs. 21-24, L = 2; MODEL.md section 3).
 //
 // Bond b = (i, j), length d = |x_i - x_j|, rest length d* (the bond's length in the rest shape),
@@ -79,18 +80,29 @@ KOKKOS_INLINE_FUNCTION bool fene_pow_bond_ok(double d, double d_rest, double x_m
   return math::isfinite(d) && d > 0 && d < x_max * d_rest;
 }
 
-// d* of every bond from the current positions.
+// d* of every bond from the current positions. prestretch: per cell (or one for all), the initial bond length
+// over d*: d* = the given length / prestretch (1: the given shape is the network's rest state; > 1: a network
+// under tension in it, e.g. a swollen cell; scene key cortex.bond_prestretch).
 template <class ExecutionSpace, class MemorySpace>
-BondRest<MemorySpace> make_bond_rest(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh) {
+BondRest<MemorySpace> make_bond_rest(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                                     const std::vector<double>& prestretch = {1.0}) {
   BondRest<MemorySpace> rest;
   rest.rest_length = decltype(rest.rest_length)(
       Kokkos::view_alloc(Kokkos::WithoutInitializing, "dcm::bonds::rest_length"), mesh.n_bonds);
+  Kokkos::View<double*, Kokkos::LayoutRight, MemorySpace> pre("dcm::bonds::prestretch", prestretch.size());
+  const auto pre_host = Kokkos::create_mirror_view(pre);
+  for (std::size_t c = 0; c < prestretch.size(); ++c) pre_host(c) = prestretch[c];
+  Kokkos::deep_copy(pre, pre_host);
+  const bool one = prestretch.size() == 1;
   const auto x = mesh.x;
   const auto bond = mesh.bond;
+  const auto bond_cell = mesh.bond_cell;
   const auto length = rest.rest_length;
   Kokkos::parallel_for(
       "dcm::bonds::rest_length", Kokkos::RangePolicy<ExecutionSpace>(space, 0, mesh.n_bonds),
-      KOKKOS_LAMBDA(const int b) { length(b) = norm(load3(x, bond(b, 0)) - load3(x, bond(b, 1))); });
+      KOKKOS_LAMBDA(const int b) {
+        length(b) = norm(load3(x, bond(b, 0)) - load3(x, bond(b, 1))) / pre(one ? 0 : bond_cell(b));
+      });
   return rest;
 }
 

@@ -12,6 +12,7 @@ h0 come from the scene stored in the file.
 """
 import argparse
 import os
+import signal
 import sys
 import tomllib
 
@@ -21,6 +22,7 @@ import numpy as np  # noqa: E402
 
 
 def main():
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # `| head` ends the output quietly
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out", help="a spread output folder (holding spread.h5)")
     ap.add_argument("--every", type=int, default=1, help="print every K-th frame (and the last); default 1")

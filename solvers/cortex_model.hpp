@@ -42,6 +42,7 @@ namespace dcm {
 // paper's Table 1 numbers map onto them.
 struct MechanicsParams {
   FenePowParams bonds;            // k_s (N/m), x_max
+  double bond_prestretch = 1;     // initial bond length / d* (kernels/fene_pow_bonds.hpp, make_bond_rest)
   double k_b = 0;                 // J, bending
   double k_area_local = 0;        // N/m, E = Σ k (A_t − A_t*)² / (2 A_t*)
   double k_area_global = 0;       // N/m, E = k (A − A*)² / (2 A*)
@@ -163,7 +164,11 @@ class CortexModel {
     const MechanicsParams& p = params_;
     make_cell_tables();
     update_geometry(space_, mesh_, geo_, p.h_min);
-    if (p.bonds.k_s > 0) bonds_ = make_bond_rest(space_, mesh_);
+    if (p.bonds.k_s > 0) {
+      std::vector<double> prestretch;
+      for (const MechanicsParams& q : cell_params_) prestretch.push_back(q.bond_prestretch);
+      bonds_ = make_bond_rest(space_, mesh_, prestretch);
+    }
     if (p.k_b > 0) hinges_ = make_hinge_rest(space_, mesh_);
     if (p.k_b > 0 && p.implicit_bending) bending_stiffness_ = BendingStiffness<Mem>(mesh_);
     if (p.k_area_local > 0 || p.k_area_global > 0) area_ = make_area_rest(space_, mesh_, geo_);

@@ -485,3 +485,42 @@ TEST(FenePow, ImplicitStiffnessBoundsTheStepToHalfWay) {
 }
 }  // namespace
 }  // namespace dcm
+
+namespace dcm {
+namespace {
+
+// cortex.bond_prestretch: d* = the given length / prestretch, per cell. A prestretched sphere's bonds pull
+// every node toward the centre (the tension a swollen cell carries), and its FENE energy is that of bonds at
+// stretch s; the cell given with prestretch 1 has zero bond force in its given shape.
+TEST(BondPrestretch, RestLengthsPerCellAndTheTensionOfASwollenSphere) {
+  const HostMesh sphere = make_icosphere(2, kRadius);
+  HostMesh shifted = sphere;
+  for (auto& p : shifted.nodes) p[0] += 10 * kRadius;
+  const auto mesh = upload_cells<Mem>({HostCell(sphere), HostCell(shifted)});
+  const double s = 1.5;
+  const auto plain = to_host_vector(make_bond_rest(Exec(), mesh).rest_length);
+  const auto pre = to_host_vector(make_bond_rest(Exec(), mesh, {1.0, s}).rest_length);
+  const auto cell = to_host_vector(mesh.bond_cell);
+  ASSERT_EQ(pre.size(), plain.size());
+  for (std::size_t b = 0; b < pre.size(); ++b)
+    EXPECT_NEAR(pre[b], cell[b] == 0 ? plain[b] : plain[b] / s, 1e-15 * plain[b]) << "bond " << b;
+  ForceView<Mem> f("f", mesh.n_nodes);
+  Kokkos::View<int, Mem> over("over");
+  Kokkos::deep_copy(over, -1);
+  add_fene_pow_forces(Exec(), mesh, make_bond_rest(Exec(), mesh, {1.0, s}), kFene, f, over);
+  const auto force = to_host_vector(f);
+  const int n = static_cast<int>(sphere.nodes.size());
+  double largest_rest = 0;
+  for (int i = 0; i < n; ++i) largest_rest = std::max(largest_rest, node_norm(force, i));
+  EXPECT_LT(largest_rest, 1e-20);  // cell 0: the given shape is the rest state
+  for (int i = n; i < 2 * n; ++i) {
+    double radial = 0;
+    for (int c = 0; c < 3; ++c)
+      radial += force[3 * i + c] * (shifted.nodes[i - n][c] - (c == 0 ? 10 * kRadius : 0));
+    EXPECT_LT(radial, -0.5 * node_norm(force, i) * kRadius)
+        << "node " << i - n << " of the prestretched cell";
+  }
+}
+
+}  // namespace
+}  // namespace dcm

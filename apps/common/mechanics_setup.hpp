@@ -19,6 +19,11 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
   MechanicsParams p;
   p.bonds.k_s = scene.get_real("cortex.k_s_N_per_m");
   p.bonds.x_max = scene.get_real("cortex.x_max");
+  p.bond_prestretch = scene.get_real("cortex.bond_prestretch");
+  if (!(p.bond_prestretch < p.bonds.x_max))
+    throw SceneError("cortex.bond_prestretch = " + detail::format_real(p.bond_prestretch) +
+                     " is not below cortex.x_max = " + detail::format_real(p.bonds.x_max) +
+                     ": the initial bonds would be at or past d_max");
   p.k_b = scene.get_real("cortex.k_b_J");
   p.k_area_local = scene.get_real("cortex.k_a");
   p.k_area_global = scene.get_real("cortex.k_d");
