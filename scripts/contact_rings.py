@@ -4,9 +4,12 @@
 For every frame of OUT/spread.h5 (or every K-th with --every K) it prints the time, the nodes within contact.h0_m
 of the plane ("in range"), the radius of the outermost of them about their centre, the largest and the mean
 node stretch among them (the frames' `stretch`: mean d/d* of the node's bonds; x_max is the FENE limit) and the
-mean stretch of the other nodes. A contact radius that grows while the count stays the same is the bound
+mean stretch of the other nodes, and how far the bound membrane slid: the largest in-plane displacement, since
+the frame printed before, of the nodes inside the bound disc in both (every triangle around them within h0 of
+the plane; the rim's nodes are left out). A contact radius that grows while the count stays the same is the bound
 membrane being stretched outward (docs/model/contact_line.md, "The line held at a node ring"). The plane and
-h0 come from the scene stored in the file.
+h0 come from the scene stored in the file. With pins (contact.pin_friction_N_s_per_m) the bound membrane
+does not slide.
 
   python3 scripts/contact_rings.py out/RUN [--every 4]
 """
@@ -42,7 +45,10 @@ def main():
         if not names:
             sys.exit(f"contact_rings: {path} has no frames")
         picked = names[::a.every] + ([names[-1]] if (len(names) - 1) % a.every else [])
-        print("t_s,nodes_in_range,outer_radius_m,stretch_max_in_range,stretch_mean_in_range,stretch_mean_free")
+        print("t_s,nodes_in_range,outer_radius_m,stretch_max_in_range,stretch_mean_in_range,stretch_mean_free,"
+              "bound_slide_max_m")
+        tri = f["mesh/triangles"][:]
+        x_before = near_before = None
         for name in picked:
             g = f["frames"][name]
             x, s = g["x"][:], g["stretch"][:]
@@ -54,7 +60,12 @@ def main():
             else:
                 r = s_max = s_mean = float("nan")
             s_free = s[~near].mean() if (~near).any() else float("nan")
-            print(f"{g.attrs['time']:.6g},{int(near.sum())},{r:.6g},{s_max:.4f},{s_mean:.4f},{s_free:.4f}")
+            inside = np.ones(len(x), dtype=bool)
+            np.logical_and.at(inside, tri.ravel(), np.repeat(near[tri].all(axis=1), 3))
+            both = inside & near_before if near_before is not None else np.zeros_like(near)
+            slide = np.hypot(*(x[both, :2] - x_before[both, :2]).T).max() if both.any() else float("nan")
+            x_before, near_before = x, inside
+            print(f"{g.attrs['time']:.6g},{int(near.sum())},{r:.6g},{s_max:.4f},{s_mean:.4f},{s_free:.4f},{slide:.4g}")
 
 
 if __name__ == "__main__":

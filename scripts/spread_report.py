@@ -163,7 +163,7 @@ SETTINGS = [
      "runs": {**{r: r for r in ROLES}, "fig5_k_a": "fig5_k_a_2e-3", "at_rest": "fig5_reference_to_2.4s"},
      "k_a": "k_a = 2e-3 against 6e-3 N/m (both ≥ 2000 in Table 1's numbers)",
      "balance": "fixed-Δt runs"},
-    {"title": "dcm's contact-line setting: the Derjaguin law and k_a = k_d = 2e-4 N/m "
+    {"title": "dcm's contact-line setting: the Derjaguin law, k_a = k_d = 2e-4 N/m and the bound disc pinned "
               "(scenes/hategan2004_contact_line.toml), adaptive steps",
      "runs": {**{r: "cl_" + r for r in ROLES}, "fig5_reference": "cl_hategan2004_sphered",
               "fig5_k_a": "cl_fig5_k_a_third", "at_rest": "cl_hategan2004_sphered_to_2.4s"},

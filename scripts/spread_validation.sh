@@ -53,11 +53,12 @@ queue2() {
   run fig5_k_a_2e-3 "${fig5[@]}" --set cortex.k_a=2e-3
 }
 # dcm's contact-line setting (scenes/hategan2004_contact_line.toml: the Derjaguin law, k_a = k_d = 2e-4 N/m,
-# adaptive steps; docs/VALIDATION.md, "Spreading, session 30"): the same claims, each run 4-35 s on one thread.
+# the bound disc pinned (session 33), adaptive steps; docs/VALIDATION.md, "Spreading, session 30" and "session
+# 33"): the same claims, each run 4-35 s on one thread; its Cuvelier run gets the same constants and pins.
 queue_cl() {
   local cl=(scenes/hategan2004_contact_line.toml)
   local cl_cuvelier=(scenes/cuvelier2007.toml --set time.adaptive=true --set contact.law=derjaguin
-    --set cortex.k_a=2e-4 --set cortex.k_d=2e-4 --early-window-s 2,20)
+    --set cortex.k_a=2e-4 --set cortex.k_d=2e-4 --set contact.pin_friction_N_s_per_m=1e-1 --early-window-s 2,20)
   case "$1" in
     1)
       run cl_hategan2004_sphered "${cl[@]}"
