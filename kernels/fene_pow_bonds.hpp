@@ -1,5 +1,4 @@
 #pragma once
-#include <vector>
 // In-plane elasticity of the cortex: FENE + POW per bond (paper eqs. 21-24, L = 2; MODEL.md section 3).
 //
 // Bond b = (i, j), length d = |x_i - x_j|, rest length d* (the bond's length in the rest shape),
@@ -20,6 +19,7 @@
 // shape, zero net force and torque, U'(d) = |eq. 22| - eq. 23 for a single bond, the flag at
 // 1.0001 d_max, the same result on Serial and OpenMP.
 #include <limits>
+#include <vector>
 
 #include "core/buffers.hpp"
 #include "core/cell_params.hpp"
