@@ -11,7 +11,13 @@ membrane being stretched outward (docs/model/contact_line.md, "The line held at 
 h0 come from the scene stored in the file. With pins (contact.pin_friction_N_s_per_m) the bound membrane
 does not slide.
 
+With --bonds it prints instead, for the last frame, the bond stretch d/d* by where the bond lies: between a rim
+node (in range, with a triangle not wholly in range) and a node inside the bound disc, along the rim, inside the
+disc, and in the free membrane (both ends out of range). d* is each bond's length in /mesh/x divided by
+cortex.bond_prestretch; the node means of d/d* are checked against the frame's `stretch`.
+
   python3 scripts/contact_rings.py out/RUN [--every 4]
+  python3 scripts/contact_rings.py out/RUN --bonds
 """
 import argparse
 import os
@@ -24,11 +30,37 @@ import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
 
+def bond_table(g, tri, rest_x, plane_z, h0):
+    """The bond stretch of frame g by where the bond lies (rim-inside, rim, inside, free)."""
+    x = g["x"][:]
+    near = x[:, 2] - plane_z < h0
+    inside = np.ones(len(x), dtype=bool)
+    np.logical_and.at(inside, tri.ravel(), np.repeat(near[tri].all(axis=1), 3))
+    rim = near & ~inside
+    e = np.unique(np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1), axis=0)
+    s = np.linalg.norm(x[e[:, 0]] - x[e[:, 1]], axis=1) / np.linalg.norm(rest_x[e[:, 0]] - rest_x[e[:, 1]], axis=1)
+    node_sum, node_count = np.zeros(len(x)), np.zeros(len(x))
+    for end in (0, 1):
+        np.add.at(node_sum, e[:, end], s)
+        np.add.at(node_count, e[:, end], 1)
+    off = np.abs(node_sum / node_count - g["stretch"][:]).max()
+    if off > 1e-6:
+        sys.exit(f"contact_rings: the rest lengths from /mesh/x do not give the frame's stretch (off by {off:.3g});"
+                 " this run's rest shape is not its first mesh")
+    print(f"t_s,{g.attrs['time']:.6g}")
+    print("bonds,count,stretch_mean,stretch_max")
+    for name, m in (("rim_to_inside", rim[e].any(axis=1) & inside[e].any(axis=1)), ("rim", rim[e].all(axis=1)),
+                    ("inside", inside[e].all(axis=1)), ("free", (~near[e]).all(axis=1))):
+        print(f"{name},{int(m.sum())},{s[m].mean() if m.any() else float('nan'):.4f},"
+              f"{s[m].max() if m.any() else float('nan'):.4f}")
+
+
 def main():
     signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # `| head` ends the output quietly
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out", help="a spread output folder (holding spread.h5)")
     ap.add_argument("--every", type=int, default=1, help="print every K-th frame (and the last); default 1")
+    ap.add_argument("--bonds", action="store_true", help="the last frame's bond stretch by where the bond lies")
     a = ap.parse_args()
     if a.every < 1:
         sys.exit(f"contact_rings: --every = {a.every}, allowed: 1 or more")
@@ -44,6 +76,10 @@ def main():
         names = sorted(f["frames"].keys())
         if not names:
             sys.exit(f"contact_rings: {path} has no frames")
+        if a.bonds:
+            prestretch = float(scene.get("cortex", {}).get("bond_prestretch", 1.0))
+            bond_table(f["frames"][names[-1]], f["mesh/triangles"][:], f["mesh/x"][:] / prestretch, plane_z, h0)
+            return
         picked = names[::a.every] + ([names[-1]] if (len(names) - 1) % a.every else [])
         print("t_s,nodes_in_range,outer_radius_m,stretch_max_in_range,stretch_mean_in_range,stretch_mean_free,"
               "bound_slide_max_m")
