@@ -30,12 +30,18 @@ import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
 
+def disc_interior(near, tri):
+    """The nodes in range whose every triangle lies wholly in range (the bound disc without its rim)."""
+    inside = np.ones(len(near), dtype=bool)
+    np.logical_and.at(inside, tri.ravel(), np.repeat(near[tri].all(axis=1), 3))
+    return inside
+
+
 def bond_table(g, tri, rest_x, plane_z, h0):
     """The bond stretch of frame g by where the bond lies (rim-inside, rim, inside, free)."""
     x = g["x"][:]
     near = x[:, 2] - plane_z < h0
-    inside = np.ones(len(x), dtype=bool)
-    np.logical_and.at(inside, tri.ravel(), np.repeat(near[tri].all(axis=1), 3))
+    inside = disc_interior(near, tri)
     rim = near & ~inside
     e = np.unique(np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1), axis=0)
     s = np.linalg.norm(x[e[:, 0]] - x[e[:, 1]], axis=1) / np.linalg.norm(rest_x[e[:, 0]] - rest_x[e[:, 1]], axis=1)
@@ -96,8 +102,7 @@ def main():
             else:
                 r = s_max = s_mean = float("nan")
             s_free = s[~near].mean() if (~near).any() else float("nan")
-            inside = np.ones(len(x), dtype=bool)
-            np.logical_and.at(inside, tri.ravel(), np.repeat(near[tri].all(axis=1), 3))
+            inside = disc_interior(near, tri)
             both = inside & near_before if near_before is not None else np.zeros_like(near)
             slide = np.hypot(*(x[both, :2] - x_before[both, :2]).T).max() if both.any() else float("nan")
             x_before, near_before = x, inside
