@@ -41,6 +41,8 @@ queue1() {
 }
 queue2() {
   run hategan2004_sphered_642 scenes/hategan2004_sphered.toml --set mesh.nodes=642
+  # the mesh claim's "final" radius where both meshes were continued to 2.4 s (session 34; ~3 min)
+  continue_to hategan2004_sphered_642 hategan2004_sphered_642_to_2.4s 2.4
   # Figure 5 on the paper's Hategan mesh, 2562 nodes (session 27; before, 642 nodes, where the touch-down's
   # scatter hid k_b's few per cent and the rings' quantisation gave k_a a 2% effect on the final radius).
   local fig5=(scenes/hategan2004_sphered.toml --set time.adaptive=true --set time.error_tol_m=1e-9)
@@ -64,6 +66,7 @@ queue_cl() {
       run cl_hategan2004_sphered "${cl[@]}"
       continue_to cl_hategan2004_sphered cl_hategan2004_sphered_to_2.4s 2.4
       run cl_hategan2004_sphered_642 "${cl[@]}" --set mesh.nodes=642
+      continue_to cl_hategan2004_sphered_642 cl_hategan2004_sphered_642_to_2.4s 2.4  # still spreading at 1.2 s
       run cl_hategan2004_biconcave_642 "${cl[@]}" --set mesh.nodes=642 --set mesh.shape=evans_fung
       run cl_cuvelier2007 "${cl_cuvelier[@]}"
       ;;

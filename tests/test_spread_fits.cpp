@@ -102,6 +102,32 @@ TEST(SpreadFits, ExponentOfAPowerLawInsideTheWindow) {
   EXPECT_EQ(used, 4);
 }
 
+// The onset and the exponent counted from it: a law r = A (t − t_c)^½ that begins at t_c = 0.41 s (as the
+// Cuvelier cell of the paper's model touches down, docs/VALIDATION.md) reads α = 0.54 against the run's clock
+// over 2–20 s and 1/2 from the onset the series saw; a cell in contact from the first row keeps the run's
+// clock.
+TEST(SpreadFits, ExponentCountsTimeFromTheContactOnset) {
+  const double t_c = 0.41;
+  std::vector<double> t{t_c}, r;  // a row at the onset (the last without contact), then 0.01 .. 20 s
+  for (int i = 0; i <= 83; ++i) t.push_back(1e-2 * std::pow(10.0, i / 25.0));
+  std::sort(t.begin(), t.end());
+  for (const double ti : t) r.push_back(ti <= t_c ? 0.0 : 2e-7 * std::sqrt(ti - t_c));
+  const double onset = dcm::spread_fits::contact_onset(t, r);
+  EXPECT_DOUBLE_EQ(onset, t_c);
+  int used = 0;
+  const double from_onset = dcm::spread_fits::fit_exponent(t, r, 2.0, 20.0, used, onset);
+  EXPECT_NEAR(from_onset, 0.5, 1e-12);
+  const double run_clock = dcm::spread_fits::fit_exponent(t, r, 2.0, 20.0, used);
+  EXPECT_GT(run_clock, 0.535);  // the delay steepens the slope against the run's clock (0.541)
+  // In contact from the first row: the onset is 0 and nothing changes.
+  const std::vector<double> t2{0.01, 0.02, 0.05, 0.1}, r2{1e-7, 1.4e-7, 2.3e-7, 3.2e-7};
+  EXPECT_EQ(dcm::spread_fits::contact_onset(t2, r2), 0.0);
+  EXPECT_EQ(dcm::spread_fits::fit_exponent(t2, r2, 0.01, 0.1, used, 0.0),
+            dcm::spread_fits::fit_exponent(t2, r2, 0.01, 0.1, used));
+  // No contact at all: no onset.
+  EXPECT_TRUE(std::isnan(dcm::spread_fits::contact_onset(t2, std::vector<double>(4, 0.0))));
+}
+
 // The final growth: a power law still spreading at the end gives 1 − 0.9^α to within the interpolation
 // between rows (rows log-spaced as spread writes them, the window's start between two rows); a saturated
 // relaxation r = r_∞ (1 − e^(−t/τ)) gives e^(−0.9 T/τ) (1 − e^(−0.1 T/τ)) / (1 − e^(−T/τ)) to within the

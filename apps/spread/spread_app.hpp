@@ -39,6 +39,7 @@ inline constexpr double kPi = 3.14159265358979323846;
 using Model = CortexModel<Exec>;
 using Stepper = TimeStepper<Exec>;
 using spread_fits::CapFit;
+using spread_fits::contact_onset;
 using spread_fits::final_growth;
 using spread_fits::fit_cap;
 using spread_fits::fit_exponent;

@@ -50,15 +50,26 @@ inline CapFit fit_cap(const std::vector<double>& x, double plane_z, bool free_me
   return f;
 }
 
-// Least-squares slope of log r against log t over the rows with from ≤ t ≤ to and r > 0; NaN with fewer than
-// three such rows or all of them at one time (used says how many there were).
+// When the contact began, as the series saw it: the time of the last row without contact (r = 0) before the
+// first row with it, or 0 when the first row already has contact (a cell placed in contact); NaN when no row
+// has contact. The true onset lies between this row and the next.
+inline double contact_onset(const std::vector<double>& t, const std::vector<double>& r) {
+  for (std::size_t i = 0; i < t.size() && i < r.size(); ++i)
+    if (r[i] > 0) return i == 0 ? 0.0 : t[i - 1];
+  return NAN;
+}
+
+// Least-squares slope of log r against log (t − origin) over the rows with from ≤ t ≤ to, t > origin and
+// r > 0; NaN with fewer than three such rows or all of them at one time (used says how many there were).
+// spread takes origin = contact_onset(): the spreading law r ∝ t^α counts time from the first contact (the
+// paper's eq. 2 integrates a da/dt ∝ W/γ_n from a = 0); the window stays in the run's own time.
 inline double fit_exponent(const std::vector<double>& t, const std::vector<double>& r, double from, double to,
-                           int& used) {
+                           int& used, double origin = 0.0) {
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
   used = 0;
   for (std::size_t i = 0; i < t.size() && i < r.size(); ++i) {
-    if (t[i] < from || t[i] > to || !(r[i] > 0)) continue;
-    const double lx = std::log(t[i]), ly = std::log(r[i]);
+    if (t[i] < from || t[i] > to || !(t[i] > origin) || !(r[i] > 0)) continue;
+    const double lx = std::log(t[i] - origin), ly = std::log(r[i]);
     sx += lx;
     sy += ly;
     sxx += lx * lx;

@@ -132,7 +132,14 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   const CapFit cap = fit_cap(x, m.plane_z, false), cap_free = fit_cap(x, m.plane_z, true);
   int used = 0;
   const SpreadOptions& so = m.so;
-  const double alpha = fit_exponent(m.ts, m.rs, so.early_from_s, so.early_to_s, used);
+  // The early exponent counts time from the contact's onset (spread_fits.hpp; docs/model/spread.md); the
+  // slope against the run's own clock is kept beside it (early_exponent_run_time, spread's only one before
+  // session 34).
+  const double onset = contact_onset(m.ts, m.rs);
+  const double alpha =
+      fit_exponent(m.ts, m.rs, so.early_from_s, so.early_to_s, used, std::isnan(onset) ? 0.0 : onset);
+  int used_run_time = 0;
+  const double alpha_run_time = fit_exponent(m.ts, m.rs, so.early_from_s, so.early_to_s, used_run_time);
   // Whether the cell still spreads at the end: r_cc's growth over the last tenth of the series (its last row
   // is the end state's, except in a run stopped between rows).
   const double t_rows = m.ts.empty() ? t : m.ts.back();
@@ -186,6 +193,8 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
       .add("early_exponent", alpha)
       .add("early_window_s", std::vector<double>{so.early_from_s, so.early_to_s})
       .add("early_window_rows", used)
+      .add("contact_onset_s", onset)
+      .add("early_exponent_run_time", alpha_run_time)
       .add("r_cc_growth_last_tenth", growth)
       .add("contact_nodes_final", near_final)
       .add("contact_nodes_most", m.contact_nodes.most)
@@ -206,7 +215,9 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   if (!m.options.quiet) {
     // No exponent (null in summary.json) when fewer than three series rows with contact lie in the window.
     char exponent[96];
-    if (std::isfinite(alpha))
+    if (std::isfinite(alpha) && onset > 0)
+      std::snprintf(exponent, sizeof exponent, "%.3f from the contact at %.3g s", alpha, onset);
+    else if (std::isfinite(alpha))
       std::snprintf(exponent, sizeof exponent, "%.3f", alpha);
     else
       std::snprintf(exponent, sizeof exponent, "none (%d rows with contact in the window)", used);

@@ -99,6 +99,24 @@ def main():
         expected = (rc[-1] - r_start) / rc[-1]
         if s["r_cc_growth_last_tenth"] is None or abs(s["r_cc_growth_last_tenth"] - expected) > 1e-6:
             fail(f"summary.json r_cc_growth_last_tenth = {s['r_cc_growth_last_tenth']}, the rows give {expected}")
+    # The contact's onset (session 34): the last row without contact before the first with it, 0 when the first
+    # row has contact; the early exponent is the slope of log r against log (t − onset) over the window's rows.
+    first = next((k for k in range(len(t)) if rc[k] > 0), None)
+    onset = None if first is None else (0.0 if first == 0 else t[first - 1])
+    if "contact_onset_s" not in s or "early_exponent_run_time" not in s:
+        fail("summary.json has no key contact_onset_s or early_exponent_run_time")
+    if onset is not None and not math.isclose(s["contact_onset_s"], onset, rel_tol=1e-6, abs_tol=1e-15):
+        fail(f"summary.json contact_onset_s = {s['contact_onset_s']}, the rows give {onset}")
+    w = s.get("early_window_s")
+    pts = [(math.log(t[k] - onset), math.log(rc[k])) for k in range(len(t))
+           if onset is not None and w[0] <= t[k] <= w[1] and t[k] > onset and rc[k] > 0]
+    if len(pts) >= 3 and not interrupted:
+        n, sx, sy = len(pts), sum(p[0] for p in pts), sum(p[1] for p in pts)
+        sxx, sxy = sum(p[0] ** 2 for p in pts), sum(p[0] * p[1] for p in pts)
+        slope = (n * sxy - sx * sy) / (n * sxx - sx * sx)
+        # series.csv holds t with 9 digits: the slope from its rows agrees to ~1e-6
+        if s["early_exponent"] is None or abs(s["early_exponent"] - slope) > 1e-4:
+            fail(f"summary.json early_exponent = {s['early_exponent']}, the rows give {slope} from t = {onset} s")
     if s.get("interrupted") != interrupted:
         fail(f"summary.json interrupted = {s.get('interrupted')}, expected {interrupted}")
     if not interrupted and not s["energy_residual_relative"] < 0.05:
