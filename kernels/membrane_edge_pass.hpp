@@ -43,19 +43,33 @@ template <class V>
 struct CellRowValues {  // MembraneScratch::cell_constants
   V kb, ks, xm2, kcf, ka, global, vol;
 };
-// The square root of a double; the vector pass brings its own. By reference: a vector argument by value would
-// change the calling convention with the ISA (-Wpsabi).
-struct ScalarSqrt {
-  KOKKOS_INLINE_FUNCTION void operator()(const double& a, double& r) const { r = math::sqrt(a); }
+// The edge's lengths and their reciprocals from the squares (all positive): |e|, |n1|, |n2| and 1/|e|, 1/gap,
+// 1/|n1|, 1/|n2|; three square roots and one division for the four reciprocals. The vector pass brings its
+// own (kernels/membrane_edge_simd.hpp). By reference: a vector argument by value would change the calling
+// convention with the ISA (-Wpsabi).
+struct ScalarRoots {
+  template <class V>
+  KOKKOS_FORCEINLINE_FUNCTION void operator()(const V& e2, const V& n1_2, const V& n2_2, const V& gap, V& len,
+                                              V& r1, V& r2, V& inv_len, V& inv_gap, V& inv_r1,
+                                              V& inv_r2) const {
+    len = math::sqrt(e2);
+    r1 = math::sqrt(n1_2);
+    r2 = math::sqrt(n2_2);
+    const V q = 1.0 / (len * gap * r1 * r2);
+    inv_len = q * gap * r1 * r2;
+    inv_gap = q * len * r1 * r2;
+    inv_r1 = q * len * gap * r2;
+    inv_r2 = q * len * gap * r1;
+  }
 };
 
 // p: the positions of i, j, k, l. Writes g (dtheta/dx of i, j, k, l), o (the force on each of them), -M =
 // -k_b sin(theta - theta*), cos(theta - theta*) and bond_ok (0 < d < d_max; false: the bond adds nothing and
 // is reported). Separate outputs, not one struct: GCC keeps arrays of this size in vector registers, and did
 // not the 1.7 KB struct of all of them.
-template <class V, class M, class Sqrt>
+template <class V, class M, class Roots>
 KOKKOS_FORCEINLINE_FUNCTION void edge_forces(const V (&p)[4][3], const EdgeRestValues<V>& rest,
-                                             const CellRowValues<V>& k, const Sqrt& sqrt_of, V (&g)[4][3],
+                                             const CellRowValues<V>& k, const Roots& roots, V (&g)[4][3],
                                              V (&o)[4][3], V& moment, V& cos_delta, M& bond_ok) {
   const V zero = V{}, one = V{} + 1.0;
   const V cos_rest = rest.cos_rest, sin_rest = rest.sin_rest, area1 = rest.area1, area2 = rest.area2;
@@ -75,14 +89,9 @@ KOKKOS_FORCEINLINE_FUNCTION void edge_forces(const V (&p)[4][3], const EdgeRestV
   const auto hinge_ok = (e2 > zero) & (n1_2 > zero) & (n2_2 > zero);
   const V e2s = e2 > zero ? e2 : one, gap = bond_ok ? d_max2 - e2 : one;
   const V n1s = n1_2 > zero ? n1_2 : one, n2s = n2_2 > zero ? n2_2 : one;
-  V len, r1, r2;  // |e|, |n1|, |n2|
-  sqrt_of(e2s, len);
-  sqrt_of(n1s, r1);
-  sqrt_of(n2s, r2);
-  // One division for the four reciprocals 1/|e|, 1/gap, 1/|n1|, 1/|n2|.
-  const V q = 1.0 / (len * gap * r1 * r2);
-  const V inv_len = q * gap * r1 * r2, inv_gap = q * len * r1 * r2;
-  const V inv_r1 = q * len * gap * r2, inv_r2 = q * len * gap * r1;
+  // |e|, |n1|, |n2| and the reciprocals of |e|, gap, |n1|, |n2|
+  V len, r1, r2, inv_len, inv_gap, inv_r1, inv_r2;
+  roots(e2s, n1s, n2s, gap, len, r1, r2, inv_len, inv_gap, inv_r1, inv_r2);
   const V inv_n1 = inv_r1 * inv_r1, inv_n2 = inv_r2 * inv_r2;  // 1/|n1|^2, 1/|n2|^2
   // U'(d)/d = k_s d_max^2 / (d_max^2 - d^2) - k_c / d^3, k_c = k_s d*^3 / (1 - 1/x_max^2) (eq. 24)
   const V k_c = kcf * d_rest * d_rest * d_rest;
@@ -178,7 +187,7 @@ struct EdgePass : EdgePassArgs {
       const CellRowValues<double> row{kb[l], ks[l], xm2[l], kcf[l], ka[l], global[l], vol[l]};
       double gl[4][3], ol[4][3];
       bool ok;
-      edge_forces(pl, rest, row, ScalarSqrt{}, gl, ol, m[l], cd[l], ok);
+      edge_forces(pl, rest, row, ScalarRoots{}, gl, ol, m[l], cd[l], ok);
       bond_bad[l] = ok ? 0 : 1;
       for (int v = 0; v < 4; ++v)
         for (int d = 0; d < 3; ++d) {

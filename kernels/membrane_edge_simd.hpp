@@ -31,13 +31,55 @@ using vd8 = double __attribute__((vector_size(64)));
 using vm8 = long long __attribute__((vector_size(64)));
 using vd4 = double __attribute__((vector_size(32)));
 
-// The square roots of eight doubles, for edge_forces() (by reference, like ScalarSqrt).
-struct VectorSqrt {
-  KOKKOS_FORCEINLINE_FUNCTION void operator()(const vd8& a, vd8& r) const {
+// The lengths and reciprocals of edge_forces() (ScalarRoots) for eight edges. With AVX-512 from the
+// hardware's 14-bit estimates of 1/sqrt(x) and 1/x and two Newton steps each (a few ulp;
+// docs/model/membrane_pass.md, "Session 34"): the three square roots and the division of ScalarRoots wait on
+// the divider, the estimates and Newton steps run on the multiply-add pipes. Otherwise square roots and one
+// division.
+struct VectorRoots {
+  KOKKOS_FORCEINLINE_FUNCTION void operator()(const vd8& e2, const vd8& n1_2, const vd8& n2_2, const vd8& gap,
+                                              vd8& len, vd8& r1, vd8& r2, vd8& inv_len, vd8& inv_gap,
+                                              vd8& inv_r1, vd8& inv_r2) const {
 #if defined(__AVX512F__)
-    r = reinterpret_cast<vd8>(
-        _mm512_mask_sqrt_pd(reinterpret_cast<__m512d>(a), 0xFF, reinterpret_cast<__m512d>(a)));
-#elif defined(__AVX__)
+    inv_len = rsqrt(e2);
+    inv_r1 = rsqrt(n1_2);
+    inv_r2 = rsqrt(n2_2);
+    len = e2 * inv_len;
+    r1 = n1_2 * inv_r1;
+    r2 = n2_2 * inv_r2;
+    inverse(gap, inv_gap);
+#else
+    sqrt8(e2, len);
+    sqrt8(n1_2, r1);
+    sqrt8(n2_2, r2);
+    const vd8 q = 1.0 / (len * gap * r1 * r2);
+    inv_len = q * gap * r1 * r2;
+    inv_gap = q * len * r1 * r2;
+    inv_r1 = q * len * gap * r2;
+    inv_r2 = q * len * gap * r1;
+#endif
+  }
+  KOKKOS_FORCEINLINE_FUNCTION static void inverse(const vd8& a, vd8& r) {  // 1/a, a > 0
+#if defined(__AVX512F__)
+    // the 14-bit estimate, then z (2 − a z) twice (14 → 28 → 53 bits)
+    vd8 z = reinterpret_cast<vd8>(_mm512_maskz_rcp14_pd(0xFF, reinterpret_cast<__m512d>(a)));
+    z = z * (2.0 - a * z);
+    r = z * (2.0 - a * z);
+#else
+    r = 1.0 / a;
+#endif
+  }
+#if defined(__AVX512F__)
+  // 1/sqrt(x), x > 0: the 14-bit estimate, then y (3 − x y²)/2 twice (14 → 28 → 53 bits).
+  KOKKOS_FORCEINLINE_FUNCTION static vd8 rsqrt(const vd8& x) {
+    vd8 y = reinterpret_cast<vd8>(_mm512_maskz_rsqrt14_pd(0xFF, reinterpret_cast<__m512d>(x)));
+    const vd8 h = 0.5 * x;
+    y = y * (1.5 - h * y * y);
+    return y * (1.5 - h * y * y);
+  }
+#else
+  KOKKOS_FORCEINLINE_FUNCTION static void sqrt8(const vd8& a, vd8& r) {
+#if defined(__AVX__)
     const __m256d lo = _mm256_sqrt_pd(_mm256_setr_pd(a[0], a[1], a[2], a[3]));
     const __m256d hi = _mm256_sqrt_pd(_mm256_setr_pd(a[4], a[5], a[6], a[7]));
     r = vd8{lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]};
@@ -45,6 +87,7 @@ struct VectorSqrt {
     for (int l = 0; l < 8; ++l) r[l] = __builtin_sqrt(a[l]);
 #endif
   }
+#endif
 };
 
 // {p[idx[0]], p[idx[s]], ..., p[idx[7 s]]} and {p[0], p[s], ..., p[7 s]}.
@@ -136,7 +179,7 @@ struct EdgePassSimd8 : EdgePassArgs {
     }
     vd8 g[4][3], o[4][3], mm, cd;
     vm8 bond_ok;
-    edge_forces(p, rest, row, VectorSqrt{}, g, o, mm, cd, bond_ok);
+    edge_forces(p, rest, row, VectorRoots{}, g, o, mm, cd, bond_ok);
     long long any_bad = 0;  // a bond at or past d_max, or NaN (the lanes' test above)
     for (int l = 0; l < W; ++l) any_bad |= ~bond_ok[l];
     if (any_bad)
