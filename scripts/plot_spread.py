@@ -47,7 +47,10 @@ def nearest(frame_list, t):
 
 
 def plot_rcc(out, s, summary):
-    t, r = s["t_s"], s["r_cc_m"]
+    # Time counts from the contact's onset (summary.json contact_onset_s, as the early exponent does; 0 for a cell
+    # placed in contact): a cell that needs a while to touch down (the Cuvelier set) shows its power law straight.
+    onset = summary.get("contact_onset_s") or 0.0
+    t, r = s["t_s"] - onset, s["r_cc_m"]
     keep = (t > 0) & (r > 0)
     fig, ax = plt.subplots(figsize=(5.5, 4.2))
     ax.loglog(t[keep], r[keep] * 1e6, "-", color="C0", label="dcm: r_cc(t)")
@@ -55,26 +58,24 @@ def plot_rcc(out, s, summary):
         t0, r0 = t[keep][len(t[keep]) // 4], r[keep][len(t[keep]) // 4] * 1e6
         tt = np.array([t[keep][0], t[keep][-1]])
         ax.loglog(tt, r0 * (tt / t0) ** 0.5, "k--", lw=0.8, label=r"$\propto t^{1/2}$")
+        # the first contact can be a sliver of a triangle (1e-9 µm): keep three decades below the largest r_cc
+        ax.set_ylim(bottom=max(r[keep].min(), 1e-3 * r[keep].max()) * 1e6 / 1.5)
     alpha = summary.get("early_exponent")
     w = summary.get("early_window_s", [])
-    # The early exponent counts time from the contact's onset (summary.json contact_onset_s; 0 for a cell placed in
-    # contact): the fit r ∝ (t − onset)^α is drawn against the run's t.
-    onset = summary.get("contact_onset_s") or 0.0
     if alpha is not None and np.isfinite(alpha) and len(w) == 2:
-        m = keep & (t >= w[0]) & (t <= w[1]) & (t > onset)
+        m = keep & (s["t_s"] >= w[0]) & (s["t_s"] <= w[1])
         if m.sum() >= 2:
-            c = np.polyfit(np.log(t[m] - onset), np.log(r[m] * 1e6), 1)
-            since = f" from the contact at {onset:.2g} s" if onset > 0 else ""
-            ax.loglog(t[m], np.exp(np.polyval(c, np.log(t[m] - onset))), "C3-", lw=2.5, alpha=0.6,
-                      label=f"fit {w[0]:g}-{w[1]:g} s: slope {alpha:.2f}{since}")
+            c = np.polyfit(np.log(t[m]), np.log(r[m] * 1e6), 1)
+            ax.loglog(t[m], np.exp(np.polyval(c, np.log(t[m]))), "C3-", lw=2.5, alpha=0.6,
+                      label=f"fit over t = {w[0]:g}-{w[1]:g} s: slope {alpha:.2f}")
     # Where the contact went on growing by stretching the bound membrane (spread's note; docs/model/contact_line.md,
     # "The line held at a node ring"): a dotted line at the time the last node came within h0 of the plane.
     since, t_last, edge = (summary.get(k) for k in ("r_cc_growth_since_contact_nodes_most_m",
                                                     "contact_nodes_most_from_s", "mesh_edge_mean_m"))
-    if None not in (since, t_last, edge) and since > edge and t_last > 0:
-        ax.axvline(t_last, color="C2", ls=":", lw=1.2,
+    if None not in (since, t_last, edge) and since > edge and t_last > onset:
+        ax.axvline(t_last - onset, color="C2", ls=":", lw=1.2,
                    label=f"last node down ({t_last:.2g} s); then +{since * 1e6:.2f} µm by stretching")
-    ax.set_xlabel("t (s)")
+    ax.set_xlabel(f"t − {onset:.3g} s (time since the contact began)" if onset > 0 else "t (s)")
     ax.set_ylabel(r"$r_{cc}$ (µm)")
     ax.set_title(f"{summary.get('scene', '')}: {summary.get('nodes', '')} nodes")
     ax.legend(fontsize=8)
