@@ -254,8 +254,7 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
         "  %snote: r_cc grew %.3g um after the last node came within contact.h0_m of the plane (t = %.3g s, "
         "%.0f nodes), more than the mesh's mean edge (%.3g um): the contact grows by stretching the membrane "
         "already bound, not by binding more of it; pins on the bound nodes (contact.pin_friction_N_s_per_m, "
-        "the "
-        "paper's option) hold it (docs/model/contact_line.md)\n",
+        "the paper's option) hold it (docs/model/contact_line.md)\n",
         m.cell > 0 || !m.so.batch.empty() ? (m.out_dir + ": ").c_str() : "",
         m.contact_nodes.growth_since(r_final) * 1e6, m.contact_nodes.t, m.contact_nodes.most,
         m.edge_mean * 1e6);
