@@ -41,7 +41,7 @@ queue1() {
 }
 queue2() {
   run hategan2004_sphered_642 scenes/hategan2004_sphered.toml --set mesh.nodes=642
-  # the mesh claim's "final" radius where both meshes were continued to 2.4 s (session 34; ~3 min)
+  # the mesh claim's "final" radius where both meshes were continued to 2.4 s (session 34; 339 s on one thread)
   continue_to hategan2004_sphered_642 hategan2004_sphered_642_to_2.4s 2.4
   # Figure 5 on the paper's Hategan mesh, 2562 nodes (session 27; before, 642 nodes, where the touch-down's
   # scatter hid k_b's few per cent and the rings' quantisation gave k_a a 2% effect on the final radius).
