@@ -11,8 +11,9 @@
 //   spread.h5/.xmf  mesh, series (every column of series.csv), frames (every output.frame_every_s and at
 //                t = 0.1, 0.35, 0.9 s) with the per-node normal force and pressure, cortex tension (eq. 1)
 //                and stretch; not with output.hdf5 = false
-//   summary.json r_cc_final_m, contact_angle_deg, early_exponent (+ window), height_final_m, steps, wall_s,
-//                mean_cg_iterations, energy balance, warnings (steps that did not resolve the run), ...
+//   summary.json r_cc_final_m, contact_angle_deg, early_exponent (+ window, contact_onset_s), height_final_m,
+//                steps, wall_s, mean_cg_iterations, energy balance, warnings (steps that did not resolve the
+//                run), ...
 // A new run removes an earlier run's files from its folder first (a restart continues them).
 //   r_cc.png, cells.png, side_views.png (scripts/plot_spread.py) unless --no-plot
 //   checkpoint.h5 the state at the end, on Ctrl-C and every output.checkpoint_every_s of wall time;
@@ -69,8 +70,10 @@ int main(int argc, char** argv) {
   std::vector<double> window;
   app.add_option(
          "--early-window-s", window,
-         "Time window FROM,TO (s) of the early power-law fit (default 0.01,0.1; a --restart keeps the "
-         "run's own unless given)")
+         "Time window FROM,TO (s) of the early power-law fit, in the run's time; the fit counts time from "
+         "the "
+         "contact's onset (summary.json contact_onset_s) (default 0.01,0.1; a --restart keeps the run's own "
+         "unless given)")
       ->delimiter(',')
       ->expected(2);
   app.add_option(
