@@ -171,6 +171,13 @@ SETTINGS = [
               "at_rest_642": "cl_hategan2004_sphered_642_to_2.4s"},
      "k_a": "k_a / 3: 6.67e-5 against 2e-4 N/m (Table 1's 2000 against 6000)",
      "balance": "its runs"},
+    {"title": "dcm's crease experiment: the contact-line setting with the fillet at the rim "
+              "(contact.crease_radius_m = 1.02e-8 m, session 34)",
+     "runs": {**{r: "clc_" + r for r in ROLES}, "fig5_reference": "clc_hategan2004_sphered",
+              "fig5_k_a": "clc_fig5_k_a_third", "at_rest": "clc_hategan2004_sphered_to_2.4s",
+              "at_rest_642": "clc_hategan2004_sphered_642_to_2.4s"},
+     "k_a": "k_a / 3: 6.67e-5 against 2e-4 N/m (Table 1's 2000 against 6000)",
+     "balance": "its runs"},
 ]
 
 

@@ -6,7 +6,8 @@
 # with QUEUE 1 or 2 the other queue's folders, possibly of older code, are judged too).
 # Takes about 20 minutes on 2 cores (session 16: 20.4 min; session 27: see docs/VALIDATION.md).
 # (The full paper scenes: build/bin/spread scenes/<scene>.toml.)
-#   bash scripts/spread_validation.sh [QUEUE]    # QUEUE = 1, 2, both (default) or cl (the contact-line runs only)
+#   bash scripts/spread_validation.sh [QUEUE]    # QUEUE = 1, 2, both (default), cl (the contact-line runs,
+#                                                # with and without the crease) or crease (the crease runs only)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 builddir=$(bash scripts/build.sh release spread | tail -n 1)
@@ -57,34 +58,44 @@ queue2() {
 # dcm's contact-line setting (scenes/hategan2004_contact_line.toml: the Derjaguin law, k_a = k_d = 2e-4 N/m,
 # the bound disc pinned (session 33), adaptive steps; docs/VALIDATION.md, "Spreading, session 30" and "session
 # 33"): the same claims, each run 4-35 s on one thread; its Cuvelier run gets the same constants and pins.
-queue_cl() {
-  local cl=(scenes/hategan2004_contact_line.toml)
+queue_cl() {  # part (1 or 2), then the folder prefix and any extra spread arguments (the crease setting)
+  local part=$1 p=${2:-cl_}
+  shift 2 || shift $#
+  local extra=("$@")
+  local cl=(scenes/hategan2004_contact_line.toml "${extra[@]}")
   local cl_cuvelier=(scenes/cuvelier2007.toml --set time.adaptive=true --set contact.law=derjaguin
-    --set cortex.k_a=2e-4 --set cortex.k_d=2e-4 --set contact.pin_friction_N_s_per_m=1e-1 --early-window-s 2,20)
-  case "$1" in
+    --set cortex.k_a=2e-4 --set cortex.k_d=2e-4 --set contact.pin_friction_N_s_per_m=1e-1 --early-window-s 2,20
+    "${extra[@]}")
+  case "$part" in
     1)
-      run cl_hategan2004_sphered "${cl[@]}"
-      continue_to cl_hategan2004_sphered cl_hategan2004_sphered_to_2.4s 2.4
-      run cl_hategan2004_sphered_642 "${cl[@]}" --set mesh.nodes=642
-      continue_to cl_hategan2004_sphered_642 cl_hategan2004_sphered_642_to_2.4s 2.4  # still spreading at 1.2 s
-      run cl_hategan2004_biconcave_642 "${cl[@]}" --set mesh.nodes=642 --set mesh.shape=evans_fung
-      run cl_cuvelier2007 "${cl_cuvelier[@]}"
+      run "${p}hategan2004_sphered" "${cl[@]}"
+      continue_to "${p}hategan2004_sphered" "${p}hategan2004_sphered_to_2.4s" 2.4
+      run "${p}hategan2004_sphered_642" "${cl[@]}" --set mesh.nodes=642
+      continue_to "${p}hategan2004_sphered_642" "${p}hategan2004_sphered_642_to_2.4s" 2.4  # still spreading at 1.2 s
+      run "${p}hategan2004_biconcave_642" "${cl[@]}" --set mesh.nodes=642 --set mesh.shape=evans_fung
+      run "${p}cuvelier2007" "${cl_cuvelier[@]}"
       ;;
     2)
-      run cl_fig5_W_x2 "${cl[@]}" --set contact.W_J_per_m2=2e-3
-      run cl_fig5_gamma_n_half "${cl[@]}" --set contact.gamma_n_N_s_per_m3=4e9
-      run cl_fig5_k_b_x2 "${cl[@]}" --set cortex.k_b_J=480e-21
-      run cl_fig5_x_max_2.5 "${cl[@]}" --set cortex.x_max=2.5
-      run cl_fig5_k_a_third "${cl[@]}" --set cortex.k_a=6.67e-5
+      run "${p}fig5_W_x2" "${cl[@]}" --set contact.W_J_per_m2=2e-3
+      run "${p}fig5_gamma_n_half" "${cl[@]}" --set contact.gamma_n_N_s_per_m3=4e9
+      run "${p}fig5_k_b_x2" "${cl[@]}" --set cortex.k_b_J=480e-21
+      run "${p}fig5_x_max_2.5" "${cl[@]}" --set cortex.x_max=2.5
+      run "${p}fig5_k_a_third" "${cl[@]}" --set cortex.k_a=6.67e-5
       ;;
   esac
 }
+# dcm's crease experiment (session 34; kernels/contact_crease.hpp, docs/model/contact_line.md "The crease at
+# the rim"): the contact-line setting with the fillet radius sqrt(sqrt(3) k_b / 4W) = 1.02e-8 m of Table 1's
+# k_b and W (kept fixed in the Figure 5 runs), folders clc_*.
+crease=(--set contact.crease_radius_m=1.02e-8)
 case "${1:-both}" in
-  1) queue1; queue_cl 1 ;;
-  2) queue2; queue_cl 2 ;;
-  cl) queue_cl 1 & queue_cl 2 & wait ;;
-  both) { queue1; queue_cl 1; } & { queue2; queue_cl 2; } & wait ;;
-  *) echo "usage: $0 [1|2|cl|both]" >&2; exit 2 ;;
+  1) queue1; queue_cl 1 cl_; queue_cl 1 clc_ "${crease[@]}" ;;
+  2) queue2; queue_cl 2 cl_; queue_cl 2 clc_ "${crease[@]}" ;;
+  cl) { queue_cl 1 cl_; queue_cl 1 clc_ "${crease[@]}"; } & { queue_cl 2 cl_; queue_cl 2 clc_ "${crease[@]}"; } & wait ;;
+  crease) queue_cl 1 clc_ "${crease[@]}" & queue_cl 2 clc_ "${crease[@]}" & wait ;;
+  both) { queue1; queue_cl 1 cl_; queue_cl 1 clc_ "${crease[@]}"; } &
+    { queue2; queue_cl 2 cl_; queue_cl 2 clc_ "${crease[@]}"; } & wait ;;
+  *) echo "usage: $0 [1|2|cl|crease|both]" >&2; exit 2 ;;
 esac
 # The paper's claims against these runs (docs/VALIDATION.md "Status at a glance" holds the same rows).
 py=$(command -v /usr/bin/python3 || command -v python3)  # Debian's, with h5py and numpy (scripts/deps.sh)

@@ -22,6 +22,7 @@
 #include "core/update_geometry.hpp"
 #include "kernels/area_constraints.hpp"
 #include "kernels/bending.hpp"
+#include "kernels/contact_crease.hpp"
 #include "kernels/cortex_diagnostics.hpp"
 #include "kernels/external_forces.hpp"
 #include "kernels/fene_pow_bonds.hpp"
@@ -67,7 +68,8 @@ struct MechanicsParams {
   Plane plane;
   PlaneContactParams contact;
   double gamma_n = 0, gamma_t = 0;
-  double pin_friction = 0;  // N·s/m on nodes fully in contact (the paper's pinning); 0: off
+  double pin_friction = 0;   // N·s/m on nodes fully in contact (the paper's pinning); 0: off
+  double crease_radius = 0;  // m, the fillet at the contact line (kernels/contact_crease.hpp); 0: off
   bool lumped_friction =
       true;  // substrate friction w_i Γ_t per node (false: β_i β_j Γ_t), friction_operator.hpp
   bool area_friction_weights = true;  // lumped: w_i from the friction area's centroid (false: the load's)
@@ -113,6 +115,7 @@ inline std::string batch_mismatch(const MechanicsParams& a, const MechanicsParam
            a.contact.friction_on_adhesive_zone != b.contact.friction_on_adhesive_zone},
       {"substrate friction on/off", on(a.gamma_n) != on(b.gamma_n) || on(a.gamma_t) != on(b.gamma_t) ||
                                         on(a.pin_friction) != on(b.pin_friction)},
+      {"the crease at the contact line on/off", on(a.crease_radius) != on(b.crease_radius)},
       {"the membrane pass (fused or per term)", a.fused_membrane != b.fused_membrane},
       {"lumped substrate friction",
        a.lumped_friction != b.lumped_friction || a.area_friction_weights != b.area_friction_weights},
@@ -187,6 +190,8 @@ class CortexModel {
       if (p.gamma_n > 0 || p.gamma_t > 0 || p.pin_friction > 0)
         enable_substrate_friction(friction_, *contact_, p.gamma_n, p.gamma_t, p.plane.normal, p.pin_friction,
                                   p.lumped_friction, p.area_friction_weights);
+      if (p.crease_radius > 0)
+        crease_ = CreaseLaw{p.contact.material.W, p.contact.material.h0, p.crease_radius, p.plane};
     }
     for (const MechanicsParams& q : cell_params_)
       friction_.cell_rows.push_back({q.dashpot, q.dashpot_transverse, q.gamma_n, q.gamma_t, q.pin_friction});
@@ -351,6 +356,7 @@ class CortexModel {
       compute_plane_contact(space_, mesh_, geo_, params_.plane, contact_params_, *contact_);
       add_plane_contact_forces(space_, mesh_, params_.plane, *contact_, force_);
     }
+    if (crease_) add_crease_forces(space_, mesh_, *crease_, force_);
     const int bad_node = first_non_finite_node(space_, force_);
     if (bad_node >= 0)
       throw NumericalError("non-finite force at node " + std::to_string(bad_node) +
@@ -386,6 +392,8 @@ class CortexModel {
     if (area_)
       add(area_energy(space_, mesh_, geo_, *area_, k_area_local_.table(), k_area_global_.table(), out), e);
     if (volume_) add(volume_energy(space_, mesh_, geo_, *volume_, k_volume_.table(), out), e);
+    if (crease_)
+      add(crease_energy(space_, mesh_, *crease_, out), e);  // the contact line's crease, with the cortex
     return e;
   }
 
@@ -694,6 +702,9 @@ class CortexModel {
                        add_plane_contact_forces(space_, mesh_, params_.plane, *contact_, scratch);
                      })) != "")
       return t;
+    if (crease_ &&
+        (t = check("contact crease", [&] { add_crease_forces(space_, mesh_, *crease_, scratch); })) != "")
+      return t;
     return "external force or positions";
   }
 
@@ -759,6 +770,7 @@ class CortexModel {
   std::optional<TensionStiffness<Mem>> tension_stiffness_;
   std::optional<Vector> gravity_;
   std::optional<ContactBuffers<Mem>> contact_;
+  std::optional<CreaseLaw> crease_;
   // The curvature and the rounded triangles' spheres are updated each step only for the paper's contact law
   // (core/update_geometry.hpp); refresh_curvature() brings them up to date for output.
   bool rounded_geometry_ = true;

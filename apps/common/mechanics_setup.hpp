@@ -61,6 +61,7 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
     p.gamma_n = scene.get_real("contact.gamma_n_N_s_per_m3");
     p.gamma_t = scene.get_real("contact.gamma_t_N_s_per_m3");
     p.pin_friction = scene.get_real("contact.pin_friction_N_s_per_m");
+    p.crease_radius = scene.get_real("contact.crease_radius_m");
     p.lumped_friction = scene.get_string("contact.friction_weights") != "consistent";
     p.area_friction_weights = scene.get_string("contact.friction_weights") == "area";
   }
