@@ -181,7 +181,7 @@ std::vector<ParamSpec> make_schema() {
           "contact.crease_radius_m", "0", 0, 1e-6, kIncl, "m",
           "dcm's experiment (session 34): the fillet radius ρ of the membrane leaving the plane; each rim "
           "edge stores W ρ |e| tan(turn/2) per wing, the adhesion a sharp fold loses against the fillet "
-          "(kernels/contact_crease.hpp; √(k_b/2W) ≈ 1.1e-8 m for Table 1; 0: off)"),
+          "(kernels/contact_crease.hpp; √(√3 k_b/4W) = 1.02e-8 m for Table 1; 0: off)"),
 
       real_key("time.dt_s", "6e-6", 0, 1, kExcl, "s", "time step (with time.adaptive: the first step)"),
       real_key("time.t_end_s", "1.2", 0, 1e6, kExcl, "s",

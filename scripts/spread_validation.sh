@@ -63,9 +63,15 @@ queue_cl() {  # part (1 or 2), then the folder prefix and any extra spread argum
   shift 2 || shift $#
   local extra=("$@")
   local cl=(scenes/hategan2004_contact_line.toml "${extra[@]}")
+  # The crease's fillet radius follows W and k_b, rho = sqrt(sqrt(3) k_b / 4W): W x 2, k_b x 2 and Cuvelier's W
+  local rho_w=() rho_kb=() rho_cuv=()
+  if [ "$p" = clc_ ]; then
+    rho_w=(--set contact.crease_radius_m=7.21e-9) rho_kb=(--set contact.crease_radius_m=1.44e-8)
+    rho_cuv=(--set contact.crease_radius_m=3.44e-8)
+  fi
   local cl_cuvelier=(scenes/cuvelier2007.toml --set time.adaptive=true --set contact.law=derjaguin
     --set cortex.k_a=2e-4 --set cortex.k_d=2e-4 --set contact.pin_friction_N_s_per_m=1e-1 --early-window-s 2,20
-    "${extra[@]}")
+    "${extra[@]}" "${rho_cuv[@]}")
   case "$part" in
     1)
       run "${p}hategan2004_sphered" "${cl[@]}"
@@ -76,9 +82,9 @@ queue_cl() {  # part (1 or 2), then the folder prefix and any extra spread argum
       run "${p}cuvelier2007" "${cl_cuvelier[@]}"
       ;;
     2)
-      run "${p}fig5_W_x2" "${cl[@]}" --set contact.W_J_per_m2=2e-3
+      run "${p}fig5_W_x2" "${cl[@]}" --set contact.W_J_per_m2=2e-3 "${rho_w[@]}"
       run "${p}fig5_gamma_n_half" "${cl[@]}" --set contact.gamma_n_N_s_per_m3=4e9
-      run "${p}fig5_k_b_x2" "${cl[@]}" --set cortex.k_b_J=480e-21
+      run "${p}fig5_k_b_x2" "${cl[@]}" --set cortex.k_b_J=480e-21 "${rho_kb[@]}"
       run "${p}fig5_x_max_2.5" "${cl[@]}" --set cortex.x_max=2.5
       run "${p}fig5_k_a_third" "${cl[@]}" --set cortex.k_a=6.67e-5
       ;;
@@ -86,7 +92,7 @@ queue_cl() {  # part (1 or 2), then the folder prefix and any extra spread argum
 }
 # dcm's crease experiment (session 34; kernels/contact_crease.hpp, docs/model/contact_line.md "The crease at
 # the rim"): the contact-line setting with the fillet radius sqrt(sqrt(3) k_b / 4W) = 1.02e-8 m of Table 1's
-# k_b and W (kept fixed in the Figure 5 runs), folders clc_*.
+# k_b and W (and of each run's W and k_b), folders clc_*.
 crease=(--set contact.crease_radius_m=1.02e-8)
 case "${1:-both}" in
   1) queue1; queue_cl 1 cl_; queue_cl 1 clc_ "${crease[@]}" ;;
