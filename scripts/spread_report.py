@@ -153,31 +153,34 @@ def verdict(ok):
     return "–" if ok is None else ("**yes**" if ok else "**no**")
 
 
-# The two settings judged: the paper's model, and dcm's contact-line setting (docs/model/contact_line.md). Each
-# maps the runs a claim needs (by role) to the folder names scripts/spread_validation.sh gives them.
+# The settings judged: the paper's model, dcm's contact-line setting (docs/model/contact_line.md) and, since
+# session 34, that setting with the crease at the rim. Each maps the runs a claim needs (by role) to the folder
+# names scripts/spread_validation.sh gives them.
 ROLES = ["hategan2004_sphered", "hategan2004_sphered_642", "hategan2004_biconcave_642", "cuvelier2007",
          "fig5_reference", "fig5_W_x2", "fig5_gamma_n_half", "fig5_k_b_x2", "fig5_x_max_2.5", "fig5_k_a",
          "at_rest", "at_rest_642"]
+
+
+def contact_line_setting(prefix, title):
+    """dcm's contact-line setting (and its variants) run by spread_validation.sh's queue_cl under a folder prefix."""
+    return {"title": title,
+            "runs": {**{r: prefix + r for r in ROLES}, "fig5_reference": prefix + "hategan2004_sphered",
+                     "fig5_k_a": prefix + "fig5_k_a_third", "at_rest": prefix + "hategan2004_sphered_to_2.4s",
+                     "at_rest_642": prefix + "hategan2004_sphered_642_to_2.4s"},
+            "k_a": "k_a / 3: 6.67e-5 against 2e-4 N/m (Table 1's 2000 against 6000)",
+            "balance": "its runs"}
+
+
 SETTINGS = [
     {"title": "The paper's model: rounded triangles with the Maugis–Dugdale law, Table 1 in dcm's reading",
      "runs": {**{r: r for r in ROLES}, "fig5_k_a": "fig5_k_a_2e-3", "at_rest": "fig5_reference_to_2.4s",
               "at_rest_642": "hategan2004_sphered_642_to_2.4s"},
      "k_a": "k_a = 2e-3 against 6e-3 N/m (both ≥ 2000 in Table 1's numbers)",
      "balance": "fixed-Δt runs"},
-    {"title": "dcm's contact-line setting: the Derjaguin law, k_a = k_d = 2e-4 N/m and the bound disc pinned "
-              "(scenes/hategan2004_contact_line.toml), adaptive steps",
-     "runs": {**{r: "cl_" + r for r in ROLES}, "fig5_reference": "cl_hategan2004_sphered",
-              "fig5_k_a": "cl_fig5_k_a_third", "at_rest": "cl_hategan2004_sphered_to_2.4s",
-              "at_rest_642": "cl_hategan2004_sphered_642_to_2.4s"},
-     "k_a": "k_a / 3: 6.67e-5 against 2e-4 N/m (Table 1's 2000 against 6000)",
-     "balance": "its runs"},
-    {"title": "dcm's crease experiment: the contact-line setting with the fillet at the rim "
-              "(contact.crease_radius_m = 1.02e-8 m, session 34)",
-     "runs": {**{r: "clc_" + r for r in ROLES}, "fig5_reference": "clc_hategan2004_sphered",
-              "fig5_k_a": "clc_fig5_k_a_third", "at_rest": "clc_hategan2004_sphered_to_2.4s",
-              "at_rest_642": "clc_hategan2004_sphered_642_to_2.4s"},
-     "k_a": "k_a / 3: 6.67e-5 against 2e-4 N/m (Table 1's 2000 against 6000)",
-     "balance": "its runs"},
+    contact_line_setting("cl_", "dcm's contact-line setting: the Derjaguin law, k_a = k_d = 2e-4 N/m and the bound "
+                         "disc pinned (scenes/hategan2004_contact_line.toml), adaptive steps"),
+    contact_line_setting("clc_", "dcm's crease experiment: the contact-line setting with the fillet at the rim "
+                         "(contact.crease_radius_m = 1.02e-8 m, session 34)"),
 ]
 
 
