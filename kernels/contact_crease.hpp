@@ -16,8 +16,10 @@
 // The forces are the exact negative gradient of E_h (tests/test_contact_crease.cpp: central differences),
 // gathered per node over the node's hinges (each hinge recomputed at its four nodes: no atomics, a fixed
 // order). The energy is counted with the cortex energy (CortexModel::energy()), so spread's energy balance
-// holds.
+// holds. W, h0 and ρ are each hinge's cell's (`laws`: one CreaseLaw for every cell, or a CellTable of them
+// for a batch of cells with different constants, core/cell_params.hpp).
 #include "core/buffers.hpp"
+#include "core/cell_params.hpp"
 #include "core/segmented_sum.hpp"
 #include "core/vec3.hpp"
 #include "kernels/plane_contact_triangle.hpp"
@@ -95,12 +97,12 @@ KOKKOS_INLINE_FUNCTION double crease_hinge(Real3 xi, Real3 xj, Real3 xk, Real3 x
 }
 
 // force += the crease forces (a gather per node over its hinges).
-template <class ExecutionSpace, class MemorySpace>
-void add_crease_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                       const CreaseLaw& law,
+template <class ExecutionSpace, class MemorySpace, class Laws>
+void add_crease_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh, const Laws& laws,
                        const Kokkos::View<double* [3], Kokkos::LayoutRight, MemorySpace>& force) {
   const auto x = mesh.x;
   const auto hinge = mesh.hinge;
+  const auto hinge_cell = mesh.hinge_cell;
   const auto offsets = mesh.node_hinge_offsets;
   const auto roles = mesh.node_hinge_roles;
   Kokkos::parallel_for(
@@ -111,7 +113,7 @@ void add_crease_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpac
           const int h = roles(s) >> 2, a = roles(s) & 3;  // 4 h + role
           Real3 f[4];
           crease_hinge(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
-                       load3(x, hinge(h, 3)), law, f);
+                       load3(x, hinge(h, 3)), cell_value(laws, hinge_cell(h)), f);
           sum += f[a];
         }
         force(i, 0) += sum.x;
@@ -121,17 +123,18 @@ void add_crease_forces(const ExecutionSpace& space, const MeshBuffers<MemorySpac
 }
 
 // Σ_h E_h (J).
-template <class ExecutionSpace, class MemorySpace>
-double crease_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh, const CreaseLaw& law,
+template <class ExecutionSpace, class MemorySpace, class Laws>
+double crease_energy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh, const Laws& laws,
                      std::vector<double>* per_cell = nullptr) {
   const auto x = mesh.x;
   const auto hinge = mesh.hinge;
+  const auto hinge_cell = mesh.hinge_cell;
   return fixed_order_sum(
       "dcm::contact::crease_energy", space, mesh.hinge_sums,
       KOKKOS_LAMBDA(const int h) {
         Real3 f[4];
         return crease_hinge(load3(x, hinge(h, 0)), load3(x, hinge(h, 1)), load3(x, hinge(h, 2)),
-                            load3(x, hinge(h, 3)), law, f);
+                            load3(x, hinge(h, 3)), cell_value(laws, hinge_cell(h)), f);
       },
       per_cell);
 }

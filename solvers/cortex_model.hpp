@@ -190,8 +190,12 @@ class CortexModel {
       if (p.gamma_n > 0 || p.gamma_t > 0 || p.pin_friction > 0)
         enable_substrate_friction(friction_, *contact_, p.gamma_n, p.gamma_t, p.plane.normal, p.pin_friction,
                                   p.lumped_friction, p.area_friction_weights);
-      if (p.crease_radius > 0)
-        crease_ = CreaseLaw{p.contact.material.W, p.contact.material.h0, p.crease_radius, p.plane};
+      if (p.crease_radius > 0) {  // each cell's own W, h0 and fillet radius (on in every cell or in none)
+        std::vector<CreaseLaw> laws;
+        for (const MechanicsParams& q : cell_params_)
+          laws.push_back(CreaseLaw{q.contact.material.W, q.contact.material.h0, q.crease_radius, p.plane});
+        crease_ = PerCell<CreaseLaw, Mem>(laws, "dcm::model::crease");
+      }
     }
     for (const MechanicsParams& q : cell_params_)
       friction_.cell_rows.push_back({q.dashpot, q.dashpot_transverse, q.gamma_n, q.gamma_t, q.pin_friction});
@@ -356,7 +360,7 @@ class CortexModel {
       compute_plane_contact(space_, mesh_, geo_, params_.plane, contact_params_, *contact_);
       add_plane_contact_forces(space_, mesh_, params_.plane, *contact_, force_);
     }
-    if (crease_) add_crease_forces(space_, mesh_, *crease_, force_);
+    if (crease_) add_crease_forces(space_, mesh_, crease_->table(), force_);
     const int bad_node = first_non_finite_node(space_, force_);
     if (bad_node >= 0)
       throw NumericalError("non-finite force at node " + std::to_string(bad_node) +
@@ -393,7 +397,8 @@ class CortexModel {
       add(area_energy(space_, mesh_, geo_, *area_, k_area_local_.table(), k_area_global_.table(), out), e);
     if (volume_) add(volume_energy(space_, mesh_, geo_, *volume_, k_volume_.table(), out), e);
     if (crease_)
-      add(crease_energy(space_, mesh_, *crease_, out), e);  // the contact line's crease, with the cortex
+      add(crease_energy(space_, mesh_, crease_->table(), out),
+          e);  // the contact line's crease, with the cortex
     return e;
   }
 
@@ -702,8 +707,8 @@ class CortexModel {
                        add_plane_contact_forces(space_, mesh_, params_.plane, *contact_, scratch);
                      })) != "")
       return t;
-    if (crease_ &&
-        (t = check("contact crease", [&] { add_crease_forces(space_, mesh_, *crease_, scratch); })) != "")
+    if (crease_ && (t = check("contact crease",
+                              [&] { add_crease_forces(space_, mesh_, crease_->table(), scratch); })) != "")
       return t;
     return "external force or positions";
   }
@@ -770,7 +775,7 @@ class CortexModel {
   std::optional<TensionStiffness<Mem>> tension_stiffness_;
   std::optional<Vector> gravity_;
   std::optional<ContactBuffers<Mem>> contact_;
-  std::optional<CreaseLaw> crease_;
+  std::optional<PerCell<CreaseLaw, Mem>> crease_;  // per cell; empty: off
   // The curvature and the rounded triangles' spheres are updated each step only for the paper's contact law
   // (core/update_geometry.hpp); refresh_curvature() brings them up to date for output.
   bool rounded_geometry_ = true;

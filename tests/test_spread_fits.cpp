@@ -119,13 +119,22 @@ TEST(SpreadFits, ExponentCountsTimeFromTheContactOnset) {
   EXPECT_NEAR(from_onset, 0.5, 1e-12);
   const double run_clock = dcm::spread_fits::fit_exponent(t, r, 2.0, 20.0, used);
   EXPECT_GT(run_clock, 0.535);  // the delay steepens the slope against the run's clock (0.541)
-  // In contact from the first row: the onset is 0 and nothing changes.
+  // A sliver of contact that came and went before the lasting contact (a touch at the lowest node) does not
+  // move the onset, nor does a row with NaN.
+  std::vector<double> r_sliver = r;
+  r_sliver[3] = 1e-15;
+  r_sliver[5] = NAN;
+  ASSERT_LT(t[5], t_c);
+  EXPECT_DOUBLE_EQ(dcm::spread_fits::contact_onset(t, r_sliver), t_c);
+  // In contact from the first row: the onset is 0.
   const std::vector<double> t2{0.01, 0.02, 0.05, 0.1}, r2{1e-7, 1.4e-7, 2.3e-7, 3.2e-7};
   EXPECT_EQ(dcm::spread_fits::contact_onset(t2, r2), 0.0);
-  EXPECT_EQ(dcm::spread_fits::fit_exponent(t2, r2, 0.01, 0.1, used, 0.0),
-            dcm::spread_fits::fit_exponent(t2, r2, 0.01, 0.1, used));
   // No contact at all: no onset.
   EXPECT_TRUE(std::isnan(dcm::spread_fits::contact_onset(t2, std::vector<double>(4, 0.0))));
+  // The contact lost at the end: the onset of the last run of contact.
+  const std::vector<double> r3{0.0, 1e-7, 0.0, 2e-7, 3e-7, 0.0};
+  const std::vector<double> t3{0.0, 0.01, 0.02, 0.03, 0.04, 0.05};
+  EXPECT_EQ(dcm::spread_fits::contact_onset(t3, r3), 0.02);
 }
 
 // The final growth: a power law still spreading at the end gives 1 − 0.9^α to within the interpolation

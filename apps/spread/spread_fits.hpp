@@ -50,18 +50,21 @@ inline CapFit fit_cap(const std::vector<double>& x, double plane_z, bool free_me
   return f;
 }
 
-// When the contact began, as the series saw it: the time of the last row without contact (r = 0) before the
-// first row with it, or 0 when the first row already has contact (a cell placed in contact); NaN when no row
-// has contact. The true onset lies between this row and the next.
+// When the lasting contact began, as the series saw it: the time of the last row without contact (r = 0 or
+// NaN) before the last unbroken run of rows with contact, or 0 when that run starts at the first row (a cell
+// placed in contact); NaN when no row has contact. The true onset lies between this row and the next. A
+// sliver of contact that came and went before (a touch at the mesh's lowest node) does not count.
 inline double contact_onset(const std::vector<double>& t, const std::vector<double>& r) {
-  for (std::size_t i = 0; i < t.size() && i < r.size(); ++i)
-    if (r[i] > 0) return i == 0 ? 0.0 : t[i - 1];
-  return NAN;
+  std::size_t i = std::min(t.size(), r.size());
+  while (i > 0 && !(r[i - 1] > 0)) --i;  // past the rows after the last contact
+  if (i == 0) return NAN;
+  while (i > 0 && r[i - 1] > 0) --i;  // back to the first row of that run
+  return i == 0 ? 0.0 : t[i - 1];
 }
 
 // Least-squares slope of log r against log (t − origin) over the rows with from ≤ t ≤ to, t > origin and
 // r > 0; NaN with fewer than three such rows or all of them at one time (used says how many there were).
-// spread takes origin = contact_onset(): the spreading law r ∝ t^α counts time from the first contact (the
+// spread takes origin = contact_onset(): the spreading law r ∝ t^α counts time from the contact's onset (the
 // paper's eq. 2 integrates a da/dt ∝ W/γ_n from a = 0); the window stays in the run's own time.
 inline double fit_exponent(const std::vector<double>& t, const std::vector<double>& r, double from, double to,
                            int& used, double origin = 0.0) {

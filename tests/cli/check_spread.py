@@ -99,9 +99,13 @@ def main():
         expected = (rc[-1] - r_start) / rc[-1]
         if s["r_cc_growth_last_tenth"] is None or abs(s["r_cc_growth_last_tenth"] - expected) > 1e-6:
             fail(f"summary.json r_cc_growth_last_tenth = {s['r_cc_growth_last_tenth']}, the rows give {expected}")
-    # The contact's onset (session 34): the last row without contact before the first with it, 0 when the first
-    # row has contact; the early exponent is the slope of log r against log (t − onset) over the window's rows.
-    first = next((k for k in range(len(t)) if rc[k] > 0), None)
+    # The contact's onset (session 35): the last row without contact before the last unbroken run of rows with
+    # it, 0 when that run starts at the first row; the early exponent is the slope of log r against
+    # log (t − onset) over the window's rows.
+    last = next((k for k in reversed(range(len(t))) if rc[k] > 0), None)
+    first = last
+    while first is not None and first > 0 and rc[first - 1] > 0:
+        first -= 1
     onset = None if first is None else (0.0 if first == 0 else t[first - 1])
     if "contact_onset_s" not in s or "early_exponent_run_time" not in s:
         fail("summary.json has no key contact_onset_s or early_exponent_run_time")
