@@ -396,9 +396,8 @@ class CortexModel {
     if (area_)
       add(area_energy(space_, mesh_, geo_, *area_, k_area_local_.table(), k_area_global_.table(), out), e);
     if (volume_) add(volume_energy(space_, mesh_, geo_, *volume_, k_volume_.table(), out), e);
-    if (crease_)
-      add(crease_energy(space_, mesh_, crease_->table(), out),
-          e);  // the contact line's crease, with the cortex
+    // the contact line's crease, counted with the cortex
+    if (crease_) add(crease_energy(space_, mesh_, crease_->table(), out), e);
     return e;
   }
 
