@@ -13,7 +13,7 @@ docs = [pathlib.Path(d).resolve() for d in sys.argv[3:]] or [src / "README.md"] 
 # A command runs from `build/bin/APP` to the closing backtick of its code span (which may wrap lines).
 cmd_re = re.compile(r"build/bin/([A-Za-z_][A-Za-z0-9_-]*)([^`]*)")
 flag_re = re.compile(r"(?<![\w-])(--[a-z][a-z0-9-]*)")
-set_re = re.compile(r"--set[\s=]+([a-z_][a-z0-9_.]*)=([^\s\]`]*)")
+set_re = re.compile(r"--set[\s=]+([a-z_][A-Za-z0-9_.]*)=([^\s\]`]*)")
 
 def is_command_head(before):
     """True when what precedes build/bin/APP in its code span is only environment settings, `time` or
@@ -40,7 +40,7 @@ def app_help(app):
 
 keys_out = subprocess.run([str(bindir / "spread"), "--list-keys"], capture_output=True, text=True,
                           timeout=60).stdout
-keys = set(re.findall(r"^\| `([a-z_0-9.]+)`", keys_out, re.M))
+keys = set(re.findall(r"^\| `([A-Za-z_0-9.]+)`", keys_out, re.M))
 if len(keys) < 20:
     sys.exit(f"spread --list-keys gave {len(keys)} keys; cannot check")
 
@@ -58,13 +58,16 @@ def check_command(app, rest, where):
     for scene in re.findall(r"(?<![\w/.-])((?:scenes|tests)/[\w/.-]+\.toml)", rest):
         if not (src / scene).exists():
             problems.append(f"{where}: {scene} does not exist")
-    for key, value in set_re.findall(rest):
+    sets = set_re.findall(rest)
+    for key, value in sets:
         if key not in keys:
             problems.append(f"{where}: --set {key}: not a scene key")
         elif re.fullmatch(r"[-+.\w\"']+", value) and not re.fullmatch(r"[A-Z]+", value):
             # checked by the command's own app when it has --check (apps differ: spread needs the plane)
             checker = app if re.search(r"--check(?![a-z-])", h) else "spread"
-            pairs.setdefault((checker, key, value), where)
+            # with the command's other --set pairs: a value allowed only together with another (a start gap
+            # beyond the range with gravity on) is checked alone first, then in its command
+            pairs.setdefault((checker, key, value), (where, [f"{k}={v}" for k, v in sets]))
 
 
 for doc in docs:
@@ -106,11 +109,19 @@ if not sys.argv[3:]:
                 except subprocess.TimeoutExpired:
                     problems.append(f"{exe.name} --help: example `{line.strip()}`: --check did not answer in 60 s")
 
-# The values: each documented KEY=VALUE (placeholders such as N or <run> left out) must pass spread --check.
-for (checker, key, value), where in sorted(pairs.items()):
+# The values: each documented KEY=VALUE (placeholders such as N or <run> left out) must pass spread --check,
+# alone or with the other --set pairs of the command that shows it.
+def check_sets(checker, sets):
+    args = [a for kv in sets for a in ("--set", kv)]
+    return subprocess.run([str(bindir / checker), "--check", "--quiet"] + args, capture_output=True, text=True,
+                          timeout=60, cwd=src)
+
+
+for (checker, key, value), (where, context) in sorted(pairs.items()):
     try:
-        r = subprocess.run([str(bindir / checker), "--check", "--quiet", "--set", f"{key}={value}"],
-                           capture_output=True, text=True, timeout=60, cwd=src)
+        r = check_sets(checker, [f"{key}={value}"])
+        if r.returncode != 0 and len(context) > 1 and check_sets(checker, context).returncode == 0:
+            continue
         if r.returncode != 0:
             problems.append(f"{where}: --set {key}={value}: {(r.stderr or r.stdout).strip()}")
     except subprocess.TimeoutExpired:

@@ -63,7 +63,7 @@ def plot_rcc(out, s, summary):
     alpha = summary.get("early_exponent")
     w = summary.get("early_window_s", [])
     if alpha is not None and np.isfinite(alpha) and len(w) == 2:
-        m = keep & (s["t_s"] >= w[0]) & (s["t_s"] <= w[1])
+        m = keep & (t >= w[0]) & (t <= w[1])  # the window counts from the onset too (since session 36)
         if m.sum() >= 2:
             c = np.polyfit(np.log(t[m]), np.log(r[m] * 1e6), 1)
             ax.loglog(t[m], np.exp(np.polyval(c, np.log(t[m]))), "C3-", lw=2.5, alpha=0.6,

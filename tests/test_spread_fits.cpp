@@ -137,6 +137,79 @@ TEST(SpreadFits, ExponentCountsTimeFromTheContactOnset) {
   EXPECT_EQ(dcm::spread_fits::contact_onset(t3, r3), 0.02);
 }
 
+// Why the onset is found at the steps' resolution and the window counts from it (session 36): a law
+// r = A (t − t_c)^½ that begins inside the window (t_c = 44.5 ms), rows 20 per decade. The rows place the
+// onset at the row before the first contact, 39.8 ms, 4.7 ms early; counted from there the first rows after
+// the onset sit a fraction of their true time from the origin: the old window (0.01–0.1 s of the run's time)
+// reads 1.04, a window 0.01–0.1 s after that onset 0.62. An onset known to a step (0.1 ms) reads 0.50.
+TEST(SpreadFits, TheWindowCountsFromAnOnsetKnownToAStep) {
+  const double t_c = 0.0445;
+  std::vector<double> t, r;
+  for (int i = 0; i <= 60; ++i) t.push_back(1e-3 * std::pow(10.0, i / 20.0));  // 1 ms .. 1 s
+  for (const double ti : t) r.push_back(ti <= t_c ? 0.0 : 2e-6 * std::sqrt(ti - t_c));
+  const double onset_rows = dcm::spread_fits::contact_onset(t, r);
+  ASSERT_NEAR(onset_rows, 0.0398, 1e-4);
+  int used = 0;
+  EXPECT_NEAR(dcm::spread_fits::fit_exponent(t, r, 0.01, 0.1, used, t_c), 0.5, 1e-12);
+  EXPECT_EQ(used, 9);  // the rows 0.01–0.1 s after the onset
+  EXPECT_NEAR(dcm::spread_fits::fit_exponent(t, r, 0.01, 0.1, used, t_c - 1e-4), 0.5, 0.005);
+  EXPECT_GT(dcm::spread_fits::fit_exponent(t, r, 0.01, 0.1, used, onset_rows), 0.6);
+  // The old window, in the run's time (0.0398–0.1 s), from the rows' onset:
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (t[i] >= 0.01 && t[i] <= 0.1 && t[i] > onset_rows && r[i] > 0) {
+      const double lx = std::log(t[i] - onset_rows), ly = std::log(r[i]);
+      sx += lx, sy += ly, sxx += lx * lx, sxy += lx * ly, ++n;
+    }
+  EXPECT_GT((n * sxy - sx * sy) / (n * sxx - sx * sx), 0.9);
+}
+
+// The onset at the steps' resolution: the tracker sees every step's start state until it sees contact, and
+// the rows without contact; its onset is the start of the step that made the last run of contact, between
+// the onset the rows give and the run's first row.
+TEST(SpreadFits, TheOnsetTrackerFindsTheStepThatMadeContact) {
+  dcm::spread_fits::OnsetTracker tr;
+  EXPECT_TRUE(std::isnan(tr.final_onset(false)));
+  // In contact from the start: 0.
+  tr.see(0.0, true);
+  EXPECT_EQ(tr.final_onset(true), 0.0);
+  // Steps of 1 ms from 0; the step from 41 ms makes the contact, rows every 5 ms.
+  dcm::spread_fits::OnsetTracker a;
+  for (int k = 0; k <= 60; ++k) {
+    const double t = 1e-3 * k;
+    if (k % 5 == 0 && k > 0 && k <= 41) a.row_without_contact(t);  // the rows at 5, 10, .., 40 ms
+    if (!a.in_contact) a.see(t, k >= 42);
+  }
+  EXPECT_DOUBLE_EQ(a.final_onset(true), 0.041);  // the rows alone: 0.040 (the row before the run)
+  // The step that made the contact is taken again, shorter (the time moves back to 41.5 ms, no contact yet):
+  // the onset is not yet known, then the next step makes it.
+  dcm::spread_fits::OnsetTracker b = a;
+  b.moved_back(0.0415);
+  EXPECT_FALSE(b.in_contact);
+  EXPECT_TRUE(std::isnan(b.final_onset(false)));
+  b.see(0.0415, false);
+  b.see(0.0425, true);
+  EXPECT_DOUBLE_EQ(b.final_onset(true), 0.0415);
+  // A row without contact ends the run; the next run's onset is the step that began it.
+  b.row_without_contact(0.05);
+  b.see(0.05, false);
+  b.see(0.051, false);
+  EXPECT_DOUBLE_EQ(b.final_onset(false), 0.0415);  // the contact lost at the end: the last run's onset
+  b.see(0.052, true);
+  EXPECT_DOUBLE_EQ(b.final_onset(true), 0.051);
+  // A contact that only the run's last step made: the start of that step.
+  dcm::spread_fits::OnsetTracker c;
+  c.see(0.0, false);
+  c.see(0.003, false);
+  EXPECT_DOUBLE_EQ(c.final_onset(true), 0.003);
+  // Saved and loaded (a checkpoint): the same state.
+  dcm::spread_fits::OnsetTracker d;
+  d.load(b.save());
+  EXPECT_DOUBLE_EQ(d.final_onset(true), 0.051);
+  EXPECT_TRUE(d.in_contact);
+}
+
 // The final growth: a power law still spreading at the end gives 1 − 0.9^α to within the interpolation
 // between rows (rows log-spaced as spread writes them, the window's start between two rows); a saturated
 // relaxation r = r_∞ (1 − e^(−t/τ)) gives e^(−0.9 T/τ) (1 − e^(−0.1 T/τ)) / (1 − e^(−T/τ)) to within the

@@ -70,8 +70,7 @@ int main(int argc, char** argv) {
   std::vector<double> window;
   app.add_option(
          "--early-window-s", window,
-         "Time window FROM,TO (s) of the early power-law fit, in the run's time; the fit counts time from "
-         "the "
+         "Time window FROM,TO (s) of the early power-law fit, counted, as the fit counts time, from the "
          "contact's onset (summary.json contact_onset_s) (default 0.01,0.1; a --restart keeps the run's own "
          "unless given)")
       ->delimiter(',')

@@ -113,6 +113,8 @@ struct Member {
   std::vector<double> ts, rs, areas_c, heights;  // series columns the summary's fits use
   std::vector<double> series_rows;               // every series row (kSeriesColumns values each), for HDF5
   spread_fits::ContactNodes contact_nodes;       // over the series rows (summary.json, the binding note)
+  spread_fits::OnsetTracker onset;               // the contact's onset at the steps' resolution
+  bool onset_by_steps = true;  // false: continued from a checkpoint before session 36 (rows)
   std::string csv_text = series_header();
   // The row of the last sampled step (kSeriesColumns values, then the step's start energy and the nodes
   // within h0 of the plane), written once the next step has accepted that step: an adaptive step may take the

@@ -62,16 +62,73 @@ inline double contact_onset(const std::vector<double>& t, const std::vector<doub
   return i == 0 ? 0.0 : t[i - 1];
 }
 
-// Least-squares slope of log r against log (t − origin) over the rows with from ≤ t ≤ to, t > origin and
-// r > 0; NaN with fewer than three such rows or all of them at one time (used says how many there were).
-// spread takes origin = contact_onset(): the spreading law r ∝ t^α counts time from the contact's onset (the
-// paper's eq. 2 integrates a da/dt ∝ W/γ_n from a = 0); the window stays in the run's own time.
+// The contact's onset at the resolution of the steps (spread, since session 36). The rows alone place it only
+// between two rows (contact_onset above), up to a row interval late or early: a cell that needs a while to
+// touch down (a gap closed under gravity, the Cuvelier set's weak adhesion) then had its first rows after the
+// onset at a fraction of that interval from it, and the early exponent moved by ±0.1 with where in the
+// interval the onset fell. spread shows the tracker the state before every step while it has seen no contact
+// (see), and tells it of each series row without contact (row_without_contact): onset is the start of the
+// step whose end state first had contact, in the last run of contact seen, the same run contact_onset takes
+// from the rows, so contact_onset(rows) ≤ onset < the time of the run's first row.
+struct OnsetTracker {
+  double onset = NAN;   // the start of the last run of contact seen (s); NaN: none yet
+  double before = NAN;  // the onset of the run before it (back in place if the step that began it is redone)
+  double t_free = 0;    // the last time a state without contact was seen
+  double t_seen = NAN;  // the time the current run of contact was first seen
+  bool in_contact =
+      false;  // the last state seen had contact; while false, spread shows it every step's start
+
+  // The state at time t (the start of a step) has contact or not.
+  void see(double t, bool contact) {
+    if (!contact) {
+      t_free = t;
+      in_contact = false;
+    } else if (!in_contact) {
+      before = onset;
+      onset = t_free;
+      t_seen = t;
+      in_contact = true;
+    }
+  }
+  // The time is t again after a step was taken again, shorter: if that step began the run, it did not yet.
+  void moved_back(double t) {
+    if (in_contact && t < t_seen) {
+      in_contact = false;
+      onset = before;
+    }
+  }
+  // A series row at time t without contact: the run of contact ended (seen at the rows' resolution).
+  void row_without_contact(double t) {
+    if (in_contact) in_contact = false;
+    t_free = std::max(t_free, t);
+  }
+  // The onset at the end of the run, whose last row (the end state) has contact or not: a contact that only
+  // the run's last step made has not been seen at a step's start.
+  double final_onset(bool last_row_has_contact) const {
+    return last_row_has_contact && !in_contact ? t_free : onset;
+  }
+  std::vector<double> save() const { return {onset, before, t_free, t_seen, in_contact ? 1.0 : 0.0}; }
+  void load(const std::vector<double>& v) {
+    onset = v[0];
+    before = v[1];
+    t_free = v[2];
+    t_seen = v[3];
+    in_contact = v[4] != 0;
+  }
+};
+
+// Least-squares slope of log r against log (t − origin) over the rows with from ≤ t − origin ≤ to, t >
+// origin and r > 0; NaN with fewer than three such rows or all of them at one time (used says how many there
+// were). spread takes origin = the contact's onset: the spreading law r ∝ t^α counts time from it (the
+// paper's eq. 2 integrates a da/dt ∝ W/γ_n from a = 0), and so does the window (since session 36; it was the
+// run's own time, so an onset inside the window put the first rows after it a fraction of a row interval from
+// the origin, where the onset's uncertainty, up to a row interval, moved the slope by ±0.1).
 inline double fit_exponent(const std::vector<double>& t, const std::vector<double>& r, double from, double to,
                            int& used, double origin = 0.0) {
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
   used = 0;
   for (std::size_t i = 0; i < t.size() && i < r.size(); ++i) {
-    if (t[i] < from || t[i] > to || !(t[i] > origin) || !(r[i] > 0)) continue;
+    if (t[i] - origin < from || t[i] - origin > to || !(t[i] > origin) || !(r[i] > 0)) continue;
     const double lx = std::log(t[i] - origin), ly = std::log(r[i]);
     sx += lx;
     sy += ly;

@@ -35,6 +35,7 @@ void commit_row(Member& m) {
   m.areas_c.push_back(row[2]);
   m.heights.push_back(row[7]);
   m.series_rows.insert(m.series_rows.end(), row.begin(), row.begin() + kSeriesColumns.size());
+  if (!(row[1] > 0)) m.onset.row_without_contact(row[0]);
   if (row.size() > kSeriesColumns.size() + 1)  // a row pending in a checkpoint before session 32 has no count
     m.contact_nodes.add_row(row[kSeriesColumns.size() + 1], row[0], row[1]);
   append_h5_series(m, row.data());
@@ -74,6 +75,7 @@ void write_checkpoint_now(Member& m, const Model& model, const Stepper& stepper,
   c.put("app.pending_row", m.pending_row);
   c.put("app.contact_nodes", std::vector<double>{m.contact_nodes.most, m.contact_nodes.t, m.contact_nodes.r});
   c.put("app.h_last", m.h_last);
+  if (m.onset_by_steps) c.put("app.contact_onset", m.onset.save());
   c.put("app.early_window_s", std::vector<double>{m.so.early_from_s, m.so.early_to_s});
   c.put("app.frames", m.h5 ? static_cast<double>(m.h5->frames()) : 0.0);
   if (m.h5) m.h5->flush();
@@ -132,10 +134,14 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   const CapFit cap = fit_cap(x, m.plane_z, false), cap_free = fit_cap(x, m.plane_z, true);
   int used = 0;
   const SpreadOptions& so = m.so;
-  // The early exponent counts time from the contact's onset (spread_fits.hpp; docs/model/spread.md); the
+  // The early exponent counts time from the contact's onset (spread_fits.hpp; docs/model/spread.md), found at
+  // the steps' resolution (or, for a run continued from a checkpoint before session 36, from the rows); the
   // slope against the run's own clock is kept beside it (early_exponent_run_time, spread's only one before
   // session 34).
-  const double onset = contact_onset(m.ts, m.rs);
+  const double onset_rows = contact_onset(m.ts, m.rs);
+  const double onset = !m.onset_by_steps || std::isnan(onset_rows)
+                           ? onset_rows
+                           : m.onset.final_onset(!m.rs.empty() && m.rs.back() > 0);
   const double alpha =
       fit_exponent(m.ts, m.rs, so.early_from_s, so.early_to_s, used, std::isnan(onset) ? 0.0 : onset);
   int used_run_time = 0;
@@ -194,6 +200,7 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
       .add("early_window_s", std::vector<double>{so.early_from_s, so.early_to_s})
       .add("early_window_rows", used)
       .add("contact_onset_s", onset)
+      .add("contact_onset_by", m.onset_by_steps ? "steps" : "rows")
       .add("early_exponent_run_time", alpha_run_time)
       .add("r_cc_growth_last_tenth", growth)
       .add("contact_nodes_final", near_final)
@@ -214,19 +221,21 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   summary.write(m.out_dir + "/summary.json");
   if (!m.options.quiet) {
     // No exponent (null in summary.json) when fewer than three series rows with contact lie in the window.
-    char exponent[96];
+    char exponent[160];
     if (std::isfinite(alpha) && onset > 0)
-      std::snprintf(exponent, sizeof exponent, "%.3f from the contact at %.3g s", alpha, onset);
+      std::snprintf(exponent, sizeof exponent, "%.3f over %g-%g s after the contact at %.4g s", alpha,
+                    so.early_from_s, so.early_to_s, onset);
     else if (std::isfinite(alpha))
-      std::snprintf(exponent, sizeof exponent, "%.3f", alpha);
+      std::snprintf(exponent, sizeof exponent, "%.3f over t = %g-%g s", alpha, so.early_from_s,
+                    so.early_to_s);
     else
-      std::snprintf(exponent, sizeof exponent, "none (%d rows with contact in the window)", used);
+      std::snprintf(exponent, sizeof exponent, "none (%d rows with contact %g-%g s after its onset)", used,
+                    so.early_from_s, so.early_to_s);
     std::printf(
-        "  %sr_cc = %.3f um, contact angle %.1f deg (free membrane %.1f), early exponent %s (t in [%g, %g] "
-        "s), height %.3f um; "
+        "  %sr_cc = %.3f um, contact angle %.1f deg (free membrane %.1f), early exponent %s, height %.3f um; "
         "%lld steps in %.1f s, mean CG %.1f\n",
         m.cell > 0 || !m.so.batch.empty() ? (m.out_dir + ": ").c_str() : "", r_final * 1e6, cap.angle_deg,
-        cap_free.angle_deg, exponent, so.early_from_s, so.early_to_s, (ztop - m.plane_z) * 1e6, done, wall,
+        cap_free.angle_deg, exponent, (ztop - m.plane_z) * 1e6, done, wall,
         done > 0 ? p.cg_total / done : 0.0);
   }
   // Adaptive steps control the position error, not the energy bookkeeping: say when the longest steps left

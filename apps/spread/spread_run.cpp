@@ -78,6 +78,10 @@ void restore_from_checkpoint(Member& m, Model& model, Stepper& stepper) {
     m.contact_nodes.most = NAN;  // not known: the rows before the restart did not count them
   }
   if (c.arrays.count("app.h_last")) m.h_last = c.scalar("app.h_last");
+  if (c.arrays.count("app.contact_onset"))  // since session 36
+    m.onset.load(c.array("app.contact_onset", 5));
+  else
+    m.onset_by_steps = false;  // the steps before the restart were not watched: the onset from the rows
   m.frames_before = static_cast<int>(c.scalar("app.frames"));
   // A restart may ask for denser rows or frames (output.series_per_decade, output.frame_every_s): the next
   // row and frame then come when the new cadence asks from here, not at the stored times the old cadence
@@ -250,8 +254,26 @@ struct BeforeStep {
     }
   }
 
+  // The contact's onset at the steps' resolution (spread_fits::OnsetTracker): every member that has seen no
+  // contact since its last state without it is shown the state at its time now (one contact evaluation for
+  // all of them; nothing once every member is in contact).
+  void watch_onsets() {
+    std::vector<double> area;
+    for (Member& m : ms) {
+      if (m.done || cap[m.cell] == 0 || !m.onset_by_steps || m.onset.in_contact) continue;
+      if (area.empty()) {
+        model.update_contact();
+        model.contact_area(&area);
+      }
+      m.onset.see(stepper.time(m.cell), area[m.cell] > 0);
+    }
+  }
+
   void operator()(const std::vector<double>& h_planned) {
+    for (Member& m : ms)  // before the rows: a step taken again, shorter, may not have made the contact now
+      if (!m.done) m.onset.moved_back(stepper.time(m.cell));
     commit_pending_rows();
+    watch_onsets();
     bool any_sample = false;
     std::optional<FrameData> frame;  // computed once, for every member that writes a frame now
     for (Member& m : ms) {

@@ -99,21 +99,28 @@ def main():
         expected = (rc[-1] - r_start) / rc[-1]
         if s["r_cc_growth_last_tenth"] is None or abs(s["r_cc_growth_last_tenth"] - expected) > 1e-6:
             fail(f"summary.json r_cc_growth_last_tenth = {s['r_cc_growth_last_tenth']}, the rows give {expected}")
-    # The contact's onset (session 35): the last row without contact before the last unbroken run of rows with
-    # it, 0 when that run starts at the first row; the early exponent is the slope of log r against
-    # log (t − onset) over the window's rows.
+    # The contact's onset (session 35): from the rows, the last row without contact before the last unbroken
+    # run of rows with it, 0 when that run starts at the first row; since session 36 spread finds it at the
+    # steps' resolution (contact_onset_by = "steps"), between that row and the run's first row. The early
+    # exponent is the slope of log r against log (t − onset) over the rows 0.01–0.1 s (the window) after it.
     last = next((k for k in reversed(range(len(t))) if rc[k] > 0), None)
     first = last
     while first is not None and first > 0 and rc[first - 1] > 0:
         first -= 1
     onset = None if first is None else (0.0 if first == 0 else t[first - 1])
-    if "contact_onset_s" not in s or "early_exponent_run_time" not in s:
-        fail("summary.json has no key contact_onset_s or early_exponent_run_time")
-    if onset is not None and not math.isclose(s["contact_onset_s"], onset, rel_tol=1e-6, abs_tol=1e-15):
+    if "contact_onset_s" not in s or "early_exponent_run_time" not in s or "contact_onset_by" not in s:
+        fail("summary.json has no key contact_onset_s, contact_onset_by or early_exponent_run_time")
+    if onset is not None and s["contact_onset_by"] == "steps":
+        # series.csv holds t with 9 digits
+        if not (onset * (1 - 1e-8) <= s["contact_onset_s"] < t[first] * (1 + 1e-8) or first == 0 == onset):
+            fail(f"summary.json contact_onset_s = {s['contact_onset_s']} is not between the rows' onset {onset} "
+                 f"and the run's first row {t[first]}")
+        onset = s["contact_onset_s"]
+    elif onset is not None and not math.isclose(s["contact_onset_s"], onset, rel_tol=1e-6, abs_tol=1e-15):
         fail(f"summary.json contact_onset_s = {s['contact_onset_s']}, the rows give {onset}")
     w = s.get("early_window_s")
     pts = [(math.log(t[k] - onset), math.log(rc[k])) for k in range(len(t))
-           if onset is not None and w[0] <= t[k] <= w[1] and t[k] > onset and rc[k] > 0]
+           if onset is not None and w[0] <= t[k] - onset <= w[1] and t[k] > onset and rc[k] > 0]
     if len(pts) >= 3 and not interrupted:
         n, sx, sy = len(pts), sum(p[0] for p in pts), sum(p[1] for p in pts)
         sxx, sxy = sum(p[0] ** 2 for p in pts), sum(p[0] * p[1] for p in pts)
