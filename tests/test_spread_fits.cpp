@@ -166,48 +166,55 @@ TEST(SpreadFits, TheWindowCountsFromAnOnsetKnownToAStep) {
 }
 
 // The onset at the steps' resolution: the tracker sees every step's start state until it sees contact, and
-// the rows without contact; its onset is the start of the step that made the last run of contact, between
-// the onset the rows give and the run's first row.
+// every series row (spread commits a step's row before it shows the tracker the state the step reached); its
+// onset is the start of the step that made the last run of rows with contact, between the onset the rows give
+// and that run's first row.
 TEST(SpreadFits, TheOnsetTrackerFindsTheStepThatMadeContact) {
-  dcm::spread_fits::OnsetTracker tr;
-  EXPECT_TRUE(std::isnan(tr.final_onset(false)));
-  // In contact from the start: 0.
-  tr.see(0.0, true);
-  EXPECT_EQ(tr.final_onset(true), 0.0);
-  // Steps of 1 ms from 0; the step from 41 ms makes the contact, rows every 5 ms.
-  dcm::spread_fits::OnsetTracker a;
-  for (int k = 0; k <= 60; ++k) {
-    const double t = 1e-3 * k;
-    if (k % 5 == 0 && k > 0 && k <= 41) a.row_without_contact(t);  // the rows at 5, 10, .., 40 ms
-    if (!a.in_contact) a.see(t, k >= 42);
-  }
-  EXPECT_DOUBLE_EQ(a.final_onset(true), 0.041);  // the rows alone: 0.040 (the row before the run)
-  // The step that made the contact is taken again, shorter (the time moves back to 41.5 ms, no contact yet):
-  // the onset is not yet known, then the next step makes it.
-  dcm::spread_fits::OnsetTracker b = a;
-  b.moved_back(0.0415);
-  EXPECT_FALSE(b.in_contact);
-  EXPECT_TRUE(std::isnan(b.final_onset(false)));
-  b.see(0.0415, false);
-  b.see(0.0425, true);
-  EXPECT_DOUBLE_EQ(b.final_onset(true), 0.0415);
-  // A row without contact ends the run; the next run's onset is the step that began it.
-  b.row_without_contact(0.05);
-  b.see(0.05, false);
-  b.see(0.051, false);
-  EXPECT_DOUBLE_EQ(b.final_onset(false), 0.0415);  // the contact lost at the end: the last run's onset
-  b.see(0.052, true);
-  EXPECT_DOUBLE_EQ(b.final_onset(true), 0.051);
-  // A contact that only the run's last step made: the start of that step.
-  dcm::spread_fits::OnsetTracker c;
-  c.see(0.0, false);
-  c.see(0.003, false);
-  EXPECT_DOUBLE_EQ(c.final_onset(true), 0.003);
-  // Saved and loaded (a checkpoint): the same state.
-  dcm::spread_fits::OnsetTracker d;
-  d.load(b.save());
-  EXPECT_DOUBLE_EQ(d.final_onset(true), 0.051);
-  EXPECT_TRUE(d.in_contact);
+  using dcm::spread_fits::OnsetTracker;
+  // Steps of 1 ms from 0, rows every 5 ms (and at every step if every = 1); contact(t) says which states
+  // have contact.
+  const auto run = [](OnsetTracker& tr, int from, int to, int every, const auto& contact) {
+    for (int k = from; k <= to; ++k) {
+      const double t = 1e-3 * k;
+      if (k > 0 && k % every == 0) tr.row(t, contact(t));
+      if (!tr.in_contact) tr.see(t, contact(t));
+    }
+  };
+  OnsetTracker none;
+  run(none, 0, 30, 5, [](double) { return false; });
+  EXPECT_TRUE(std::isnan(none.onset));
+  OnsetTracker from_start;  // in contact from the start: 0
+  run(from_start, 0, 30, 5, [](double) { return true; });
+  EXPECT_EQ(from_start.onset, 0.0);
+  // The step from 41 ms makes the contact: the rows alone say 40 ms (the row before the run, at 45 ms).
+  OnsetTracker a;
+  const auto from_42ms = [](double t) { return t >= 0.042 - 1e-12; };
+  run(a, 0, 60, 5, from_42ms);
+  EXPECT_DOUBLE_EQ(a.onset, 0.041);
+  // Rows at every step: the contact is first seen in the row of the step that made it.
+  OnsetTracker b;
+  run(b, 0, 60, 1, from_42ms);
+  EXPECT_DOUBLE_EQ(b.onset, 0.041);
+  // A contact seen at a step's start and gone before the next row does not count (the rows never saw it);
+  // the lasting contact after it does.
+  OnsetTracker c;
+  const auto touch_then_land = [](double t) { return (t > 0.0115 && t < 0.0135) || t >= 0.042 - 1e-12; };
+  run(c, 0, 30, 5, touch_then_land);
+  EXPECT_TRUE(std::isnan(c.onset));
+  run(c, 31, 60, 5, touch_then_land);
+  EXPECT_DOUBLE_EQ(c.onset, 0.041);
+  // The contact lost at the end (and seen again at a step's start without a row after it): the onset of the
+  // last run of rows with contact.
+  run(c, 61, 70, 5, [](double t) { return t < 0.0645; });
+  EXPECT_DOUBLE_EQ(c.onset, 0.041);
+  c.see(0.071, true);
+  EXPECT_DOUBLE_EQ(c.onset, 0.041);
+  // Saved and loaded (a checkpoint): the same state, and the next row with contact starts a run from 70 ms.
+  OnsetTracker d;
+  d.load(c.save());
+  EXPECT_DOUBLE_EQ(d.onset, 0.041);
+  d.row(0.075, true);
+  EXPECT_DOUBLE_EQ(d.onset, 0.070);
 }
 
 // The final growth: a power law still spreading at the end gives 1 − 0.9^α to within the interpolation

@@ -63,57 +63,52 @@ inline double contact_onset(const std::vector<double>& t, const std::vector<doub
 }
 
 // The contact's onset at the resolution of the steps (spread, since session 36). The rows alone place it only
-// between two rows (contact_onset above), up to a row interval late or early: a cell that needs a while to
-// touch down (a gap closed under gravity, the Cuvelier set's weak adhesion) then had its first rows after the
-// onset at a fraction of that interval from it, and the early exponent moved by ±0.1 with where in the
-// interval the onset fell. spread shows the tracker the state before every step while it has seen no contact
-// (see), and tells it of each series row without contact (row_without_contact): onset is the start of the
-// step whose end state first had contact, in the last run of contact seen, the same run contact_onset takes
-// from the rows, so contact_onset(rows) ≤ onset < the time of the run's first row.
+// between two rows (contact_onset above), up to a row interval early: a cell that needs a while to touch down
+// (a gap closed under gravity, the Cuvelier set's weak adhesion) then had its first rows after the onset at a
+// fraction of that interval from it, and the early exponent moved by ±0.1 with where in the interval the
+// onset fell. spread shows the tracker the state at every step's start while the last state it saw had no
+// contact (see; the stepper calls that point only with the steps before it accepted, so what it sees is never
+// taken back), and every series row it commits (row). Its onset is the start of the step whose end state
+// first had contact, in the last unbroken run of rows with contact, the same run contact_onset takes from the
+// rows; it is fixed when that run's first row is committed, so contact_onset(rows) ≤ onset < that row's time
+// (a contact seen at a step's start and gone before the next row does not count, as in contact_onset).
 struct OnsetTracker {
-  double onset = NAN;   // the start of the last run of contact seen (s); NaN: none yet
-  double before = NAN;  // the onset of the run before it (back in place if the step that began it is redone)
-  double t_free = 0;    // the last time a state without contact was seen
-  double t_seen = NAN;  // the time the current run of contact was first seen
+  double t_free = 0;       // the last time a state without contact was seen (a step's start or a row)
+  double candidate = NAN;  // the start of the step that made the contact the steps see now
+  double onset = NAN;      // the onset of the last run of rows with contact; NaN: no row with contact yet
   bool in_contact =
       false;  // the last state seen had contact; while false, spread shows it every step's start
+  bool row_contact = false;  // the last row committed had contact
 
-  // The state at time t (the start of a step) has contact or not.
+  // The state at time t, the start of a step, has contact or not.
   void see(double t, bool contact) {
     if (!contact) {
       t_free = t;
       in_contact = false;
     } else if (!in_contact) {
-      before = onset;
-      onset = t_free;
-      t_seen = t;
+      candidate = t_free;
       in_contact = true;
     }
   }
-  // The time is t again after a step was taken again, shorter: if that step began the run, it did not yet.
-  void moved_back(double t) {
-    if (in_contact && t < t_seen) {
+  // A series row at time t: the first row of a run of rows with contact fixes the onset (the step that made
+  // the contact: seen at a step's start before, or the row's own step); one without contact ends the run.
+  void row(double t, bool contact) {
+    if (contact && !row_contact) onset = in_contact ? candidate : t_free;
+    if (!contact) {
       in_contact = false;
-      onset = before;
+      t_free = std::max(t_free, t);
     }
+    row_contact = contact;
   }
-  // A series row at time t without contact: the run of contact ended (seen at the rows' resolution).
-  void row_without_contact(double t) {
-    if (in_contact) in_contact = false;
-    t_free = std::max(t_free, t);
+  std::vector<double> save() const {
+    return {t_free, candidate, onset, in_contact ? 1.0 : 0.0, row_contact ? 1.0 : 0.0};
   }
-  // The onset at the end of the run, whose last row (the end state) has contact or not: a contact that only
-  // the run's last step made has not been seen at a step's start.
-  double final_onset(bool last_row_has_contact) const {
-    return last_row_has_contact && !in_contact ? t_free : onset;
-  }
-  std::vector<double> save() const { return {onset, before, t_free, t_seen, in_contact ? 1.0 : 0.0}; }
   void load(const std::vector<double>& v) {
-    onset = v[0];
-    before = v[1];
-    t_free = v[2];
-    t_seen = v[3];
-    in_contact = v[4] != 0;
+    t_free = v[0];
+    candidate = v[1];
+    onset = v[2];
+    in_contact = v[3] != 0;
+    row_contact = v[4] != 0;
   }
 };
 

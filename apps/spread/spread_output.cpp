@@ -35,7 +35,7 @@ void commit_row(Member& m) {
   m.areas_c.push_back(row[2]);
   m.heights.push_back(row[7]);
   m.series_rows.insert(m.series_rows.end(), row.begin(), row.begin() + kSeriesColumns.size());
-  if (!(row[1] > 0)) m.onset.row_without_contact(row[0]);
+  m.onset.row(row[0], row[1] > 0);
   if (row.size() > kSeriesColumns.size() + 1)  // a row pending in a checkpoint before session 32 has no count
     m.contact_nodes.add_row(row[kSeriesColumns.size() + 1], row[0], row[1]);
   append_h5_series(m, row.data());
@@ -139,9 +139,7 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   // slope against the run's own clock is kept beside it (early_exponent_run_time, spread's only one before
   // session 34).
   const double onset_rows = contact_onset(m.ts, m.rs);
-  const double onset = !m.onset_by_steps || std::isnan(onset_rows)
-                           ? onset_rows
-                           : m.onset.final_onset(!m.rs.empty() && m.rs.back() > 0);
+  const double onset = m.onset_by_steps ? m.onset.onset : onset_rows;
   const double alpha =
       fit_exponent(m.ts, m.rs, so.early_from_s, so.early_to_s, used, std::isnan(onset) ? 0.0 : onset);
   int used_run_time = 0;

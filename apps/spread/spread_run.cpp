@@ -270,8 +270,6 @@ struct BeforeStep {
   }
 
   void operator()(const std::vector<double>& h_planned) {
-    for (Member& m : ms)  // before the rows: a step taken again, shorter, may not have made the contact now
-      if (!m.done) m.onset.moved_back(stepper.time(m.cell));
     commit_pending_rows();
     watch_onsets();
     bool any_sample = false;
