@@ -73,11 +73,10 @@ inline double contact_onset(const std::vector<double>& t, const std::vector<doub
 // rows; it is fixed when that run's first row is committed, so contact_onset(rows) ≤ onset < that row's time
 // (a contact seen at a step's start and gone before the next row does not count, as in contact_onset).
 struct OnsetTracker {
-  double t_free = 0;       // the last time a state without contact was seen (a step's start or a row)
-  double candidate = NAN;  // the start of the step that made the contact the steps see now
-  double onset = NAN;      // the onset of the last run of rows with contact; NaN: no row with contact yet
-  bool in_contact =
-      false;  // the last state seen had contact; while false, spread shows it every step's start
+  double t_free = 0;        // the last time a state without contact was seen (a step's start or a row)
+  double candidate = NAN;   // the start of the step that made the contact the steps see now
+  double onset = NAN;       // the onset of the last run of rows with contact; NaN: no row with contact yet
+  bool in_contact = false;  // the last state seen had contact (while not, spread shows it every step's start)
   bool row_contact = false;  // the last row committed had contact
 
   // The state at time t, the start of a step, has contact or not.
