@@ -209,7 +209,13 @@ TEST(SpreadFits, TheOnsetTrackerFindsTheStepThatMadeContact) {
   EXPECT_DOUBLE_EQ(c.onset, 0.041);
   c.see(0.071, true);
   EXPECT_DOUBLE_EQ(c.onset, 0.041);
-  // Saved and loaded (a checkpoint): the same state, and the next row with contact starts a run from 70 ms.
+  // Saved and loaded (a checkpoint, finite values only): the same state, and the next row with contact starts
+  // a run from 70 ms; a tracker that has seen no contact yet keeps its unknown times.
+  OnsetTracker unknown;
+  for (const double v : none.save()) EXPECT_TRUE(std::isfinite(v));
+  unknown.load(none.save());
+  EXPECT_TRUE(std::isnan(unknown.onset));
+  EXPECT_TRUE(std::isnan(unknown.candidate));
   OnsetTracker d;
   d.load(c.save());
   EXPECT_DOUBLE_EQ(d.onset, 0.041);

@@ -99,13 +99,17 @@ struct OnsetTracker {
     }
     row_contact = contact;
   }
+  // For a checkpoint, whose values are all finite (scripts/check_outputs_finite.py): a time not known yet
+  // (NaN) is stored as −1.
   std::vector<double> save() const {
-    return {t_free, candidate, onset, in_contact ? 1.0 : 0.0, row_contact ? 1.0 : 0.0};
+    const auto time = [](double t) { return std::isnan(t) ? -1.0 : t; };
+    return {t_free, time(candidate), time(onset), in_contact ? 1.0 : 0.0, row_contact ? 1.0 : 0.0};
   }
   void load(const std::vector<double>& v) {
+    const auto time = [](double t) { return t < 0 ? NAN : t; };
     t_free = v[0];
-    candidate = v[1];
-    onset = v[2];
+    candidate = time(v[1]);
+    onset = time(v[2]);
     in_contact = v[3] != 0;
     row_contact = v[4] != 0;
   }
