@@ -66,8 +66,10 @@ def plot_rcc(out, s, summary):
         m = keep & (t >= w[0]) & (t <= w[1])  # the window counts from the onset too (since session 36)
         if m.sum() >= 2:
             c = np.polyfit(np.log(t[m]), np.log(r[m] * 1e6), 1)
+            cut = summary.get("early_window_cut_at_s")  # the run ended inside the window
+            end = f"{cut:.3g} s (run's end; window to {w[1]:g})" if cut is not None else f"{w[1]:g} s"
             ax.loglog(t[m], np.exp(np.polyval(c, np.log(t[m]))), "C3-", lw=2.5, alpha=0.6,
-                      label=f"fit over t - t_c = {w[0]:g}-{w[1]:g} s: slope {alpha:.2f}")
+                      label=f"fit over t - t_c = {w[0]:g}-{end}: slope {alpha:.2f}")
     # Where the contact went on growing by stretching the bound membrane (spread's note; docs/model/contact_line.md,
     # "The line held at a node ring"): a dotted line at the time the last node came within h0 of the plane.
     since, t_last, edge = (summary.get(k) for k in ("r_cc_growth_since_contact_nodes_most_m",

@@ -217,7 +217,10 @@ def judge(folder, setting):
             onset, a_run = s.get("contact_onset_s"), s.get("early_exponent_run_time")
             since = "" if not onset else \
                 f" from the contact at {fmt(onset, '.3g', ' s')} (against the run's clock {fmt(a_run, '.3f')})"
-            row(claim, target, f"α = {fmt(a, '.3f')} over {fmt(w[0], 'g')}–{fmt(w[1], 'g')} s{since}",
+            cut = s.get("early_window_cut_at_s")  # the run ended inside the window (since session 37)
+            end = f"{fmt(w[1], 'g')} s" if cut is None else \
+                f"{fmt(cut, '.3g')} s (the run's end; the window to {fmt(w[1], 'g')} s)"
+            row(claim, target, f"α = {fmt(a, '.3f')} over {fmt(w[0], 'g')}–{end}{since}",
                 in_band(a, 0.4, 0.6))
 
     # Hategan set, sphered, 2562 nodes.

@@ -128,6 +128,16 @@ def main():
         # series.csv holds t with 9 digits: the slope from its rows agrees to ~1e-6
         if s["early_exponent"] is None or abs(s["early_exponent"] - slope) > 1e-4:
             fail(f"summary.json early_exponent = {s['early_exponent']}, the rows give {slope} from t = {onset} s")
+    # The window's end the rows reach: null unless the last row lies inside the window (counted from the onset).
+    reach = None if onset is None or not t else t[-1] - onset
+    cut = s.get("early_window_cut_at_s", "absent")
+    # (series.csv holds t with 9 digits: within 1e-6 of the window's ends either answer is right)
+    if reach is not None and w[0] * (1 + 1e-6) < reach < w[1] * (1 - 1e-6):
+        if cut is None or cut == "absent" or abs(cut - reach) > 1e-7 * max(1.0, t[-1]):
+            fail(f"summary.json early_window_cut_at_s = {cut}, the rows end {reach} s after the onset, inside "
+                 f"the window {w}")
+    elif cut is not None and (reach is None or not w[0] * (1 - 1e-6) < reach < w[1] * (1 + 1e-6)):
+        fail(f"summary.json early_window_cut_at_s = {cut}; the rows end {reach} s after the onset, not inside {w}")
     if s.get("interrupted") != interrupted:
         fail(f"summary.json interrupted = {s.get('interrupted')}, expected {interrupted}")
     if not interrupted and not s["energy_residual_relative"] < 0.05:
