@@ -167,7 +167,10 @@ class TimeStepper {
   }
 
   // One step of every cell c with h_cap[c] > 0, at most h_cap[c] long. observe(h) is called once, after the
-  // velocities are known and before the positions move, with each cell's step (0: not stepping).
+  // velocities are known and before the positions move, with each cell's step (0: not stepping); the model's
+  // forces and contact are then those of the current positions (the last compute_forces() was at them, after
+  // any step taken again), so observe may read contact_area() without update_contact() (spread's onset does;
+  // TimeStepper.ObserveSeesTheContactOfTheCurrentPositions).
   // Returns one report per cell (all zero for a cell that did not step).
   template <class Observe>
   std::vector<StepReport> step(Model& model, const CgSettings& cg, const std::vector<double>& h_cap,

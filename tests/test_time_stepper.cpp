@@ -206,6 +206,42 @@ TEST(TimeStepper, ContactChangeBoundsTheContactAreaPerStep) {
   EXPECT_GT(steps_on, steps_off);
 }
 
+// observe() sees the model's contact of the current positions, the same as update_contact() computes there,
+// with fixed steps and with adaptive ones that take steps again (spread's onset reads it without evaluating
+// the contact again).
+TEST(TimeStepper, ObserveSeesTheContactOfTheCurrentPositions) {
+  const double r = 3.25e-6, a = 0.3e-6, t_end = 0.002;
+  const MechanicsParams p = test_params::spreading_on_plane(r, a);
+  const HostMesh sphere = make_icosphere(3, r);
+  for (const bool adaptive : {false, true}) {
+    CortexModel<Exec> m(Exec(), {HostCell(sphere)}, p);
+    TimeStepSettings s;
+    s.adaptive = adaptive;
+    s.dt = 2e-5;
+    s.error_tol_m = 1e-9;
+    s.contact_change = adaptive ? 0.02 : 0;
+    TimeStepper<Exec> stepper(m, s);
+    int steps = 0, rejected = 0, differ = 0, in_contact = 0;
+    while (stepper.time() < t_end * (1 - 1e-12)) {
+      const StepReport rep = stepper.step(m, CgSettings{}, t_end - stepper.time(), [&](double) {
+        const double seen = m.contact_area(), load_seen = m.contact_load();
+        m.update_contact();
+        differ += seen != m.contact_area() || load_seen != m.contact_load();
+        in_contact += seen > 0;
+      });
+      rejected += rep.rejections;
+      ++steps;
+    }
+    std::printf("  %s: %d steps, %d taken again, %d with contact, %d where observe saw another contact\n",
+                adaptive ? "adaptive" : "fixed", steps, rejected, in_contact, differ);
+    EXPECT_EQ(differ, 0);
+    EXPECT_GT(in_contact, steps / 2);
+    if (adaptive) {
+      EXPECT_GT(rejected, 0) << "the case must take steps again to check that path";
+    }
+  }
+}
+
 // A solve that cannot converge (one CG iteration allowed) is retried with half the step, and after the
 // allowed halvings the run ends with a message that says so, never with garbage.
 TEST(TimeStepper, UnconvergedSolveEndsInAClearErrorAfterTheHalvings) {

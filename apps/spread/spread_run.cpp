@@ -255,16 +255,14 @@ struct BeforeStep {
   }
 
   // The contact's onset at the steps' resolution (spread_fits::OnsetTracker): every member that has seen no
-  // contact since its last state without it is shown the state at its time now (one contact evaluation for
-  // all of them; nothing once every member is in contact).
+  // contact since its last state without it is shown the state at its time now. The contact is the stepper's
+  // own, of the positions now (TimeStepper::step calls this after its last compute_forces(); until session 37
+  // spread evaluated it again here, a contact pass per step until the first contact).
   void watch_onsets() {
     std::vector<double> area;
     for (Member& m : ms) {
       if (m.done || cap[m.cell] == 0 || !m.onset_by_steps || m.onset.in_contact) continue;
-      if (area.empty()) {
-        model.update_contact();
-        model.contact_area(&area);
-      }
+      if (area.empty()) model.contact_area(&area);
       m.onset.see(stepper.time(m.cell), area[m.cell] > 0);
     }
   }
