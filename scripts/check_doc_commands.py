@@ -8,6 +8,11 @@ Usage: check_doc_commands.py SOURCE_DIR BIN_DIR [DOC.md ...]   (default: README.
 Exit 0 when every command holds, 1 listing each problem as FILE:LINE: what."""
 import pathlib, re, subprocess, sys
 
+if any(a in ("-h", "--help") for a in sys.argv[1:]):
+    print(__doc__.strip())
+    sys.exit(0)
+if len(sys.argv) < 3:
+    sys.exit("usage: check_doc_commands.py SOURCE_DIR BIN_DIR [DOC.md ...]   (--help: what it checks)")
 src, bindir = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
 docs = [pathlib.Path(d).resolve() for d in sys.argv[3:]] or [src / "README.md"] + sorted((src / "docs").rglob("*.md"))
 # A command runs from `build/bin/APP` to the closing backtick of its code span (which may wrap lines).

@@ -10,6 +10,10 @@ status 0 if all read right, 1 otherwise, 2 on bad usage. (Plain h5py, not ParaVi
 import os
 import sys
 
+if __name__ == "__main__" and any(a in ("-h", "--help") for a in sys.argv[1:]):
+    print(__doc__.strip())
+    sys.exit(0)
+
 from paraview import servermanager  # noqa: F401  (pvbatch's Python)
 from paraview.simple import Delete, XDMFReader, Xdmf3ReaderS, Xdmf3ReaderT
 

@@ -7,7 +7,12 @@ import sys
 
 
 def main(argv):
+    if any(a in ("-h", "--help") for a in argv[1:]):
+        print(__doc__.strip())
+        return 0
     args = [a for a in argv[1:] if not a.startswith("--ignore")]
+    if len(args) not in (2, 3):
+        sys.exit("usage: compare_json.py A.json B.json [REL_TOL] [--ignore=KEY,...]")
     ignore = set()
     for a in argv[1:]:
         if a.startswith("--ignore="):

@@ -104,6 +104,9 @@ def check(path):
 
 
 def main(argv):
+    if len(argv) < 2 or any(a in ("-h", "--help") for a in argv[1:]):
+        print(__doc__.strip(), file=sys.stdout if len(argv) >= 2 else sys.stderr)
+        return 0 if len(argv) >= 2 else 2
     findings = []
     for path in argv[1:]:
         findings += check(path)

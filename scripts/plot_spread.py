@@ -161,6 +161,9 @@ def plot_side_views(out, h5):
 
 def main():
     args = sys.argv[1:]
+    if any(a in ("-h", "--help") for a in args):
+        print(__doc__.strip())
+        return
     quiet = "--quiet" in args
     args = [a for a in args if a != "--quiet"]
     if len(args) != 1 or args[0].startswith("-"):

@@ -180,7 +180,7 @@ def cap_minimum(P, A0, V0, bond_rest):
     return {"theta_deg": th, "a_m": a, "A_ratio": A / A0, "V_ratio": V / V0, "height_m": h}
 
 
-def analyse(run, frame=None, time=None):
+def analyse(run, frame=None, time=None, cap_overrides=None):
     path = os.path.join(run, "spread.h5")
     P = scene_params(path)
     times = frame_times(path)
@@ -276,20 +276,28 @@ def analyse(run, frame=None, time=None):
         "bond_mean_over_dmax": sum(ratios) / len(ratios),
         "worst_bond_z_m": zw, "worst_bond_r_m": rw,
     }
-    res["cap_min"] = cap_minimum(P, A0, V0, bond_rest)
+    res["cap_min"] = cap_minimum({**P, **(cap_overrides or {})}, A0, V0, bond_rest)
     return res
 
 
 if __name__ == "__main__":
-    args = sys.argv[1:]
-    run = args[0]
-    frame = time = None
-    if "--frame" in args:
-        frame = int(args[args.index("--frame") + 1])
-    if "--time" in args:
-        time = float(args[args.index("--time") + 1])
-    r = analyse(run, frame, time)
-    if "--json" in args:
+    import argparse
+    ap = argparse.ArgumentParser(description=__doc__.strip().split("\n\n")[0])
+    ap.add_argument("run", help="a spread output folder (its spread.h5)")
+    which = ap.add_mutually_exclusive_group()
+    which.add_argument("--frame", type=int, help="frame index (default: the last)")
+    which.add_argument("--time", type=float, help="the frame nearest this time (s)")
+    ap.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    ap.add_argument("--k-a", type=float, help="cortex.k_a (N/m) for the cap-energy minimum instead of the run's")
+    ap.add_argument("--k-d", type=float, help="cortex.k_d (N/m) for the cap-energy minimum instead of the run's")
+    a = ap.parse_args()
+    if not os.path.isfile(os.path.join(a.run, "spread.h5")):
+        sys.exit(f"spread_angle_analysis: {a.run} has no spread.h5 (a spread output folder with frames)")
+    over = {k: v for k, v in (("cortex.k_a", a.k_a), ("cortex.k_d", a.k_d)) if v is not None}
+    if any(not v >= 0 for v in over.values()):
+        sys.exit(f"spread_angle_analysis: --k-a / --k-d must be 0 or more N/m, got {over}")
+    r = analyse(a.run, a.frame, a.time, over)
+    if a.json:
         print(json.dumps(r, indent=1))
     else:
         for k, v in r.items():

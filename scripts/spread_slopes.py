@@ -6,8 +6,9 @@ through its window (the paper's crossover from t^1/2 to a slower law) from one t
 
   python3 scripts/spread_slopes.py OUT [OUT ...] [--edges-s 0.003,0.01,0.03,0.1,0.3,1]
 
-Prints a CSV row per run: its folder, spread's early exponent, then the slope over each window (empty where a
-window holds fewer than three rows with contact), then r_cc (µm) at each edge, interpolated in the rows.
+Prints a CSV row per run: its folder, spread's early exponent, then the slope over each window [lo, hi) (empty
+where a window holds fewer than three rows with contact), then r_cc (µm) at each edge, interpolated linearly in
+the rows. A summary.json without contact_onset_s (a dcm before session 34) counts time from the run's start.
 """
 import argparse
 import csv
@@ -48,8 +49,10 @@ def run_row(folder, edges):
     t = [float(row["t_s"]) - onset for row in rows]
     r = [float(row["r_cc_m"]) for row in rows]
     slopes = []
-    for lo, hi in zip(edges[:-1], edges[1:]):
-        pts = [(math.log(tk), math.log(rk)) for tk, rk in zip(t, r) if lo <= tk <= hi and tk > 0 and rk > 0]
+    for k, (lo, hi) in enumerate(zip(edges[:-1], edges[1:])):
+        last = k == len(edges) - 2  # windows [lo, hi): a row on an edge counts once; the last one includes hi
+        pts = [(math.log(tk), math.log(rk)) for tk, rk in zip(t, r)
+               if lo <= tk and (tk < hi or (last and tk == hi)) and tk > 0 and rk > 0]
         slopes.append(slope(pts))
     radii = [interpolate(t, r, e) for e in edges]
     return summary.get("early_exponent"), slopes, radii

@@ -150,11 +150,15 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   const double growth = final_growth(m.ts, m.rs, 0.9 * t_rows);
   // Where the rows end inside the early window (counted from the onset): the fit saw only its part up to
   // there (the Cuvelier set's 2-20 s window of a 20-s run whose contact began at 0.42 s). NaN (null) when the
-  // rows reach past the window's end or end before its start.
-  const double origin = std::isnan(onset) ? 0.0 : onset, rows_reach = t_rows - origin;
+  // rows reach past the window's end, end before its start, or the run has no contact (no onset).
+  const double rows_reach = t_rows - onset;  // NaN without an onset
   const double window_cut_at =
       rows_reach < so.early_to_s * (1 - 1e-9) && rows_reach > so.early_from_s && !m.ts.empty() ? rows_reach
                                                                                                : NAN;
+  // The t_end that covers the window, rounded up to 4 significant digits (printed with %.4g: never short).
+  const double t_cover = onset + so.early_to_s;
+  const double digit = std::pow(10.0, std::floor(std::log10(t_cover)) - 3);
+  const double t_cover_up = std::ceil(t_cover / digit * (1 - 1e-12)) * digit;
   const double wall = m.p.wall_before + wall_now;
   const Progress& p = m.p;
   // A run that ends but did not resolve its dynamics says so (stderr, also with --quiet, and summary.json's
@@ -253,13 +257,16 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
         "controlled by time.error_tol_m, the energy balance is not resolved at these steps: lower "
         "time.dt_max_s to resolve it\n",
         residual_rel, dt_max);
-  if (!m.options.quiet && std::isfinite(window_cut_at))
+  // Said for a run that reached its t_end with an exponent (a stopped run is told how to continue below; a
+  // window with fewer than three rows has no exponent, and the summary line says so).
+  if (!m.options.quiet && std::isfinite(window_cut_at) && std::isfinite(alpha) && !m.interrupted &&
+      !m.stopped_at_max_steps)
     std::printf(
         "  %snote: the run ended %.4g s after the contact's onset, inside the early window (%g-%g s after "
-        "it): "
-        "the early exponent is fitted over %g-%.4g s; run to time.t_end_s >= %.4g for the whole window\n",
+        "it): the early exponent is fitted over %g-%.4g s; run to time.t_end_s >= %.4g for the whole "
+        "window\n",
         m.cell > 0 || !m.so.batch.empty() ? (m.out_dir + ": ").c_str() : "", window_cut_at, so.early_from_s,
-        so.early_to_s, so.early_from_s, window_cut_at, origin + so.early_to_s);
+        so.early_to_s, so.early_from_s, window_cut_at, t_cover_up);
   // A cell still spreading at the end (r_cc up by 1% or more over the last tenth of the run; one still on
   // t^(1/2) gives 5%): its final values are not the spread-out cell's.
   if (!m.options.quiet && growth >= 0.01)
