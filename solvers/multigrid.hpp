@@ -6,7 +6,8 @@
 //                                         3×3 blocks from the cached n̂_b (+ an approximation of the
 //                                         implicit bending, mg_detail::update_bending_axes), A_{l+1} = Pᵀ A_l
 //                                         P, block inverses, the coarsest level (12 nodes per cell) inverted
-//                                         densely
+//                                         densely; in two parts, update_multigrid_operator() (A_0, the
+//                                         CG's operator too) and update_multigrid_hierarchy() (the rest)
 //   apply_multigrid(space, mg, r, z)     z = M⁻¹ r, one V-cycle; the PCG precondition(r, z) callable
 // Smoother: ν sweeps of damped block-Jacobi x ← x + ω D⁻¹ (b − A x) before and the same ν after the
 // coarse correction. D is symmetric, so the post-smoother is the adjoint of the pre-smoother and the
@@ -349,18 +350,23 @@ void update_bending_axes(const ExecutionSpace& space, const MeshBuffers<MemorySp
 
 }  // namespace mg_detail
 
-// Numeric set-up, once per step after update_friction(space, mesh, op). Level 0 holds the bending's
-// approximation when the caller passes the hinges and the bending stiffness and make_multigrid() built its
-// recipe (settings.bending not off), for the cells bending_cells selects (every cell when null); the caller
-// decides step by step (MultigridSettings::Bending). A cell left out gets exactly its blocks without the
-// bending, so its preconditioner does not depend on the other cells of a batch.
+// Numeric set-up, once per step after update_friction(space, mesh, op), in two parts:
+// update_multigrid_operator() assembles level 0's blocks, which are also the CG's operator (fine_operator()),
+// and update_multigrid_hierarchy() builds what only the V-cycle needs (level 0's bending, the smoothers'
+// block inverses, the Galerkin levels, the coarsest inverses); a solve whose warm start already meets the
+// tolerance applies no preconditioner and needs only the first (CortexModel::solve_velocity builds the second
+// on the first preconditioner application). update_multigrid() does both.
+// Level 0 holds the bending's approximation when the caller passes the hinges and the bending stiffness and
+// make_multigrid() built its recipe (settings.bending not off), for the cells bending_cells selects (every
+// cell when null); the caller decides step by step (MultigridSettings::Bending). A cell left out gets exactly
+// its blocks without the bending, so its preconditioner does not depend on the other cells of a batch.
 template <class ExecutionSpace, class MemorySpace>
-void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
-                      const FrictionOperator<MemorySpace>& op, Multigrid<MemorySpace>& mg,
-                      const TensionStiffness<MemorySpace>* tension = nullptr,
-                      const HingeRest<MemorySpace>* hinges = nullptr,
-                      const BendingStiffness<MemorySpace>* bending = nullptr,
-                      const std::vector<char>* bending_cells = nullptr) {
+void update_multigrid_operator(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                               const FrictionOperator<MemorySpace>& op, Multigrid<MemorySpace>& mg,
+                               const TensionStiffness<MemorySpace>* tension = nullptr,
+                               const HingeRest<MemorySpace>* hinges = nullptr,
+                               const BendingStiffness<MemorySpace>* bending = nullptr,
+                               const std::vector<char>* bending_cells = nullptr) {
   mg.bending_in_level0 = false;
   if (hinges != nullptr && bending != nullptr && mg.operator_values.extent(0) > 0) {
     for (int c = 0; c < static_cast<int>(mg.bending_dt_k_b_host.extent(0)); ++c) {
@@ -375,12 +381,7 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
     const auto off = a.row_offsets;
     const auto val = a.values;
     const bool with_bending = mg.bending_in_level0;
-    if (with_bending) mg_detail::update_bending_axes(space, mesh, *hinges, mg);
-    const auto op_val = mg.operator_values;
-    const auto bend_off = mg.fine_slot_bending_offsets;
-    const auto bend = mg.fine_slot_bending;
-    const auto axis = mg.bending_axis;
-    const auto out = with_bending ? op_val : val;  // assemble_fine: the operator's blocks
+    const auto out = with_bending ? mg.operator_values : val;  // assemble_fine: the operator's blocks
     const auto slot_bond = mg.fine_slot_bond;
     const auto node_off = mesh.node_bond_offsets;
     const auto node_bonds = mesh.node_bonds;
@@ -427,7 +428,23 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
             for (int k = 0; k < 6; ++k) out(s, k) = blk[k];
           }
         });
-    if (with_bending)  // the preconditioner's level 0: the operator's blocks + the bending's
+  }
+}
+
+// The V-cycle's part of the set-up (above), after update_multigrid_operator() at the same positions; hinges:
+// the same as given there (for level 0's bending).
+template <class ExecutionSpace, class MemorySpace>
+void update_multigrid_hierarchy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                                Multigrid<MemorySpace>& mg, const HingeRest<MemorySpace>* hinges = nullptr) {
+  {
+    const BlockCsr<MemorySpace>& a = mg.levels[0].a;
+    const auto val = a.values;
+    if (mg.bending_in_level0) {  // the preconditioner's level 0: the operator's blocks + the bending's
+      mg_detail::update_bending_axes(space, mesh, *hinges, mg);
+      const auto op_val = mg.operator_values;
+      const auto bend_off = mg.fine_slot_bending_offsets;
+      const auto bend = mg.fine_slot_bending;
+      const auto axis = mg.bending_axis;
       Kokkos::parallel_for(
           "dcm::mg::add_bending", Kokkos::RangePolicy<ExecutionSpace>(space, 0, a.nnz),
           KOKKOS_LAMBDA(const int s) {
@@ -440,6 +457,7 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
             }
             for (int k = 0; k < 6; ++k) val(s, k) = blk[k];
           });
+    }
     block_csr_invert_diagonal(space, a);
   }
   for (std::size_t l = 1; l < mg.levels.size(); ++l) {  // A_l = Pᵀ A_{l−1} P
@@ -476,6 +494,18 @@ void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace
   }
   Kokkos::deep_copy(space, mg.coarse_inverse, mg.coarse_inverse_host);
   space.fence();  // the host mirror is rewritten next step
+}
+
+// Both parts of the numeric set-up (above).
+template <class ExecutionSpace, class MemorySpace>
+void update_multigrid(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
+                      const FrictionOperator<MemorySpace>& op, Multigrid<MemorySpace>& mg,
+                      const TensionStiffness<MemorySpace>* tension = nullptr,
+                      const HingeRest<MemorySpace>* hinges = nullptr,
+                      const BendingStiffness<MemorySpace>* bending = nullptr,
+                      const std::vector<char>* bending_cells = nullptr) {
+  update_multigrid_operator(space, mesh, op, mg, tension, hinges, bending, bending_cells);
+  update_multigrid_hierarchy(space, mesh, mg, hinges);
 }
 
 namespace mg_detail {

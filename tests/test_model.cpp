@@ -225,6 +225,45 @@ TEST(CortexModel, ImplicitBendingIsStableWhereExplicitBendingIsNot) {
   EXPECT_TRUE(implicit_ok);
 }
 
+// What only the preconditioner needs (the multigrid's hierarchy, the volume's Woodbury correction) is built
+// on its first application in a solve: a solve that iterates builds it once; one whose warm start already
+// meets the tolerance builds nothing and keeps the velocity bit for bit. (spread's outputs are the same bits
+// as with the eager build of sessions 8-36: docs/PERFORMANCE.md, "Session 37".)
+TEST(CortexModel, ThePreconditionerIsBuiltOnlyForASolveThatIterates) {
+  const HostMesh rest = make_evans_fung(3);
+  HostMesh moved = rest;
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-0.02e-6, 0.02e-6);
+  for (auto& x : moved.nodes)
+    for (double& v : x) v += u(rng);
+  MechanicsParams p = table1(6e-3, 6e-3, 1e4);
+  p.multigrid = true;
+  p.precondition_volume = true;
+  CortexModel<Exec> model(Exec(), {HostCell(rest)}, p);
+  set_positions(model, moved);
+  model.compute_forces();
+  CgSettings cg;
+  cg.abs_tol = 1e-16;
+  const CgResult first = model.solve_velocity(cg, 6e-6);
+  const long long built = model.preconditioner_builds();
+  const std::vector<double> v = to_host_vector(model.velocity());
+  cg.abs_tol =
+      1e-15;  // ten times the first solve's: its recursive residual met 1e-16, the true one meets this
+  const CgResult again = model.solve_velocity(cg, 6e-6);
+  std::printf("  first solve: %d iterations, %lld build(s); again from its velocity: %d iterations, %lld\n",
+              first.iterations, built, again.iterations, model.preconditioner_builds());
+  EXPECT_GT(first.iterations, 0);
+  EXPECT_EQ(built, 1);
+  EXPECT_EQ(again.iterations, 0);
+  EXPECT_EQ(model.preconditioner_builds(), 1);
+  EXPECT_EQ(to_host_vector(model.velocity()), v);
+  model.compute_forces();
+  cg.abs_tol = 1e-18;  // now it must iterate again, and build again
+  const CgResult tighter = model.solve_velocity(cg, 6e-6);
+  EXPECT_GT(tighter.iterations, 0);
+  EXPECT_EQ(model.preconditioner_builds(), 2);
+}
+
 // MultigridSettings::Bending::automatic: the bending's Gauss–Newton stiffness enters the multigrid's level 0
 // in the steps where bending_ratio() = Δt k_b R² / (c h⁴) reaches 0.15 (solvers/multigrid.hpp), and there it
 // saves iterations; on the paper's Δt on 642 nodes it stays out.
