@@ -7,7 +7,9 @@
 // from P alone:
 //     M⁻¹ = P − w wᵀ / (1/s + uᵀw),   w = P u   (P symmetric),
 // symmetric positive definite whenever P is (it is (P⁻¹ + s u uᵀ)⁻¹), so PCG stays PCG.
-//   update_global_woodbury()   once per step, after the preconditioner's and the global stiffness's updates:
+//   update_global_woodbury()   once per solve that applies the preconditioner (CortexModel::solve_velocity
+//                              builds it on the first application), after the preconditioner's and the
+//                              global stiffness's updates:
 //                              w = P u (one application of P for all cells at once: P is block-diagonal per
 //                              cell) and per cell 1/s + uᵀw
 //   apply_global_woodbury()    after z = P r in the preconditioner: z −= w (wᵀr) / (1/s + uᵀw), per cell

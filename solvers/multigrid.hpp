@@ -105,12 +105,12 @@ struct Multigrid {
   View<int*> fine_slot_bending_offsets, fine_slot_bending;
   View<double* [7]> bending_axis;
   // Per cell, the Δt k_b level 0 holds (0: that cell's level 0 is its operator's blocks, to the bit), and its
-  // staging copy; update_multigrid() fills them.
+  // staging copy; update_multigrid_operator() fills them.
   View<double*> bending_dt_k_b;
   typename View<double*>::host_mirror_type bending_dt_k_b_host;
   // Level 0's blocks without the bending (the CG's operator) while level 0 holds it; else empty.
   View<double* [6]> operator_values;
-  bool bending_in_level0 = false;  // of the last update_multigrid()
+  bool bending_in_level0 = false;  // of the last update_multigrid_operator()
   std::vector<MultigridLevel<MemorySpace>> levels;
   View<double***> coarse_inverse;  // per cell, the inverse of the coarsest operator (36 × 36)
   typename View<double***>::host_mirror_type coarse_inverse_host;
@@ -314,8 +314,8 @@ void galerkin_level(const ExecutionSpace& space, const Multigrid<MemorySpace>& m
   block_csr_invert_diagonal(space, lv.a);
 }
 
-// The per-hinge factors of level 0's bending blocks (update_multigrid adds them). Level 0 = the operator's
-// blocks + a positive semi-definite approximation of the implicit bending
+// The per-hinge factors of level 0's bending blocks (update_multigrid_hierarchy adds them). Level 0 = the
+// operator's blocks + a positive semi-definite approximation of the implicit bending
 // Δt k_b max(cos(θ − θ*), 0) ∇θ ∇θᵀ per hinge (solvers/bending_stiffness.hpp) on the bond pattern: each
 // role's gradient ∇_a θ is replaced by its component α_a N̂ along the hinge's normal N̂ (the direction of
 // ∇_k θ + ∇_l θ; exact for a flat hinge, where all four gradients are normal), and the wings' cross block
@@ -436,6 +436,10 @@ void update_multigrid_operator(const ExecutionSpace& space, const MeshBuffers<Me
 template <class ExecutionSpace, class MemorySpace>
 void update_multigrid_hierarchy(const ExecutionSpace& space, const MeshBuffers<MemorySpace>& mesh,
                                 Multigrid<MemorySpace>& mg, const HingeRest<MemorySpace>* hinges = nullptr) {
+  if (mg.bending_in_level0 && hinges == nullptr)
+    throw std::logic_error(
+        "update_multigrid_hierarchy: level 0 holds the bending; pass the hinges given to "
+        "update_multigrid_operator()");
   {
     const BlockCsr<MemorySpace>& a = mg.levels[0].a;
     const auto val = a.values;
