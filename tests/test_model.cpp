@@ -29,13 +29,17 @@ MechanicsParams table1(double k_local = 6e-4, double k_global = 6e-3, double k_v
   return p;
 }
 
-HostMesh perturbed_sphere(int k, double amplitude, unsigned seed) {
-  HostMesh m = make_icosphere(k, 3.25e-6);
+// m with every coordinate moved by a uniform random amount in [−amplitude, amplitude].
+HostMesh perturbed(HostMesh m, double amplitude, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-amplitude, amplitude);
   for (auto& x : m.nodes)
     for (double& v : x) v += u(rng);
   return m;
+}
+
+HostMesh perturbed_sphere(int k, double amplitude, unsigned seed) {
+  return perturbed(make_icosphere(k, 3.25e-6), amplitude, seed);
 }
 
 // Relaxation of a perturbed cell (rest state: the unperturbed sphere) under Γ v = F, x += dt v:
@@ -203,11 +207,7 @@ TEST(CortexModel, ImplicitGlobalConstraintsAreStableWhereExplicitOnesAreNot) {
 // and with the bending stiffness in the solve (Γ + Δt K_bend) it is not.
 TEST(CortexModel, ImplicitBendingIsStableWhereExplicitBendingIsNot) {
   const HostMesh rest = make_evans_fung(3);
-  HostMesh moved = rest;
-  std::mt19937 rng(9);
-  std::uniform_real_distribution<double> u(-0.01e-6, 0.01e-6);
-  for (auto& x : moved.nodes)
-    for (double& v : x) v += u(rng);
+  const HostMesh moved = perturbed(rest, 0.01e-6, 9);
   auto run = [&](bool implicit_bending) {
     MechanicsParams p = table1(6e-3, 6e-3, 1e4);
     p.implicit_bending = implicit_bending;
@@ -233,11 +233,7 @@ TEST(CortexModel, ImplicitBendingIsStableWhereExplicitBendingIsNot) {
 // the eager build of sessions 8-36: docs/PERFORMANCE.md, "Session 37".)
 TEST(CortexModel, ThePreconditionerIsBuiltOnlyForASolveThatIterates) {
   const HostMesh rest = make_evans_fung(3);
-  HostMesh moved = rest;
-  std::mt19937 rng(4);
-  std::uniform_real_distribution<double> u(-0.02e-6, 0.02e-6);
-  for (auto& x : moved.nodes)
-    for (double& v : x) v += u(rng);
+  const HostMesh moved = perturbed(rest, 0.02e-6, 4);
   MechanicsParams p = table1(6e-3, 6e-3, 1e4);
   p.multigrid = true;
   p.precondition_volume = true;
