@@ -244,6 +244,11 @@ std::vector<ParamSpec> make_schema() {
           "output.frame_every_s", "0.05", 0, 1e6, kExcl, "s",
           "simulated time between HDF5 frames (spread also writes t = 0.1, 0.35, 0.9 s and the end; relax "
           "writes a frame every 20 × --sample-every steps)"),
+      real_key("output.early_window_from_s", "0.01", 0, 1e6, kExcl, "s",
+               "spread: the early power-law fit (summary.json early_exponent) starts this long after the "
+               "contact's onset (--early-window-s overrides; the Cuvelier set's slow spreading needs 2 s)"),
+      real_key("output.early_window_to_s", "0.1", 0, 1e6, kExcl, "s",
+               "spread: ... and ends this long after it (more than output.early_window_from_s)"),
       int_key("output.series_per_decade", "40", 1, 10000,
               "rows of series.csv per decade of simulated time (log-spaced; every step for the first ten)"),
       real_key("output.checkpoint_every_s", "600", 0, 1e7, kIncl, "s",

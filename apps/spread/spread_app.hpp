@@ -49,8 +49,9 @@ extern volatile std::sig_atomic_t g_stop;
 
 struct SpreadOptions {
   bool plot = true;
-  // Window of the early power-law fit: from 10 ms (after the first triangles have touched down, r_cc of a few
-  // edge lengths) to 0.1 s (the paper: still the t^1/2 regime at 100 ms). docs/model/spread.md.
+  // Window of the early power-law fit, s after the contact's onset: the scene's output.early_window_from_s
+  // and output.early_window_to_s (defaults 10 ms, after the first triangles have touched down, to 0.1 s, the
+  // paper's t^1/2 regime at 100 ms; docs/model/spread.md), or --early-window-s (set_early_window).
   double early_from_s = 1e-2, early_to_s = 1e-1;
   bool early_window_given = false;  // --early-window-s on the command line (a restart keeps the run's own)
   std::string restart;              // checkpoint to continue from

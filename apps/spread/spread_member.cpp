@@ -110,17 +110,42 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// The window of the early power-law fit: --early-window-s, else the scene's output.early_window_from_s and
+// output.early_window_to_s (a checkpoint of sessions 28-37, whose scene has no such keys, keeps the window
+// its run used, stored as app.early_window_s). The window is written into the scene, so that the checkpoint
+// and spread.h5 carry the one the run used and a restart keeps it.
+static void set_early_window(Member& m) {
+  SpreadOptions& so = m.so;
+  Scene& scene = m.scene;
+  const char* from_key = "output.early_window_from_s";
+  const char* to_key = "output.early_window_to_s";
+  if (so.early_window_given) {
+    if (!(so.early_from_s > 0 && so.early_to_s > so.early_from_s))
+      throw SceneError("--early-window-s = " + detail::format_real(so.early_from_s) + "," +
+                       detail::format_real(so.early_to_s) + " is not allowed: need 0 < from < to");
+    scene.set(std::string(from_key) + "=" + detail::format_real(so.early_from_s));
+    scene.set(std::string(to_key) + "=" + detail::format_real(so.early_to_s));
+  } else if (m.restart && !scene.was_set(from_key) && !scene.was_set(to_key) &&
+             m.restart->arrays.count("app.early_window_s")) {
+    const std::vector<double>& w = m.restart->array("app.early_window_s", 2);
+    scene.set(std::string(from_key) + "=" + detail::format_real(w[0]));
+    scene.set(std::string(to_key) + "=" + detail::format_real(w[1]));
+  }
+  so.early_from_s = scene.get_real(from_key);
+  so.early_to_s = scene.get_real(to_key);
+  if (!(so.early_to_s > so.early_from_s))
+    throw SceneError(std::string(to_key) + " = " + detail::format_real(so.early_to_s) +
+                     " is not allowed: it must exceed " + from_key + " = " +
+                     detail::format_real(so.early_from_s) +
+                     " (the early fit's window, s after the contact's onset)");
+}
+
 void prepare_member(Member& m) {
   const SpreadOptions& so = m.so;
   if (!so.restart.empty()) {
     m.restart = read_checkpoint(so.restart);
     if (m.restart->text("app") != "spread")
       throw IoError(so.restart + ": a checkpoint of '" + m.restart->text("app") + "', not of spread");
-    if (!so.early_window_given && m.restart->arrays.count("app.early_window_s")) {  // since session 28
-      const std::vector<double>& w = m.restart->array("app.early_window_s", 2);
-      m.so.early_from_s = w[0];
-      m.so.early_to_s = w[1];
-    }
     const double steps_done = m.restart->array("app.progress").at(0);  // Progress::step
     if (so.max_steps > 0 && static_cast<double>(so.max_steps) <= steps_done)
       throw SceneError("--max-steps " + std::to_string(so.max_steps) + " is not allowed with --restart " +
@@ -128,14 +153,12 @@ void prepare_member(Member& m) {
                        " steps (--max-steps counts from the run's start); give a larger count");
   }
   m.scene = spread_scene(m.options, so, m.restart ? &*m.restart : nullptr);
+  set_early_window(m);
   const Scene& scene = m.scene;
   if (!scene.get_bool("contact.plane"))
     throw SceneError(
         "contact.plane = false: spread needs the substrate plane (set contact.plane = true, or leave "
         "the key out)");
-  if (!(so.early_from_s > 0 && so.early_to_s > so.early_from_s))
-    throw SceneError("--early-window-s = " + detail::format_real(so.early_from_s) + "," +
-                     detail::format_real(so.early_to_s) + " is not allowed: need 0 < from < to");
   const double h0 = scene.get_real("contact.h0_m"), gap = scene.get_real("contact.start_gap_m");
   const bool falls =
       scene.get_real("body.gravity_m_per_s2") > 0 && scene.get_real("body.density_excess_kg_per_m3") > 0;

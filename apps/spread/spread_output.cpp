@@ -267,6 +267,19 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
         "window\n",
         m.cell > 0 || !m.so.batch.empty() ? (m.out_dir + ": ").c_str() : "", window_cut_at, so.early_from_s,
         so.early_to_s, so.early_from_s, window_cut_at, t_cover_up);
+  // An early window that opens while the contact is a triangle or two (the Cuvelier set's 0.01-0.1 s): its
+  // slope is that of single triangles touching down (a ratio of radii of ten and more), not a power law.
+  double r_start = NAN;  // r_cc at the window's first row with contact
+  for (std::size_t i = 0; i < m.ts.size() && i < m.rs.size() && std::isnan(r_start); ++i)
+    if (m.ts[i] - (std::isnan(onset) ? 0.0 : onset) >= so.early_from_s * (1 - 1e-9) && m.rs[i] > 0)
+      r_start = m.rs[i];
+  if (!m.options.quiet && std::isfinite(alpha) && r_start < 0.5 * m.edge_mean)
+    std::printf(
+        "  %snote: the early window opens when the contact is smaller than a triangle (r_cc %.3g um %g s "
+        "after the onset; mesh edge %.3g um): its exponent follows the first triangles touching down, not a "
+        "power law; open it later (output.early_window_from_s or --early-window-s) or use a finer mesh\n",
+        m.cell > 0 || !m.so.batch.empty() ? (m.out_dir + ": ").c_str() : "", r_start * 1e6, so.early_from_s,
+        m.edge_mean * 1e6);
   // A cell still spreading at the end (r_cc up by 1% or more over the last tenth of the run; one still on
   // t^(1/2) gives 5%): its final values are not the spread-out cell's.
   if (!m.options.quiet && growth >= 0.01)
