@@ -3,7 +3,8 @@
 
     python3 scripts/plot_spread.py [--quiet] OUT_DIR
 
-r_cc.png    contact radius against time on log-log axes with a t^(1/2) guide and the fitted early slope
+r_cc.png    contact radius against time on log-log axes with a t^(1/2) guide, the fitted early slope and the
+            slope from the early window's end to the run's end
             (paper Figure 4 style), and a dotted line where the last node came down when the contact grew by
             more than a mesh edge after it (stretching of the bound membrane)
 cells.png   the cell at the frames nearest t = 0.1, 0.35, 0.9 s, coloured by the normal force per node
@@ -70,6 +71,14 @@ def plot_rcc(out, s, summary):
             end = f"{cut:.3g} s (run's end; window to {w[1]:g})" if cut is not None else f"{w[1]:g} s"
             ax.loglog(t[m], np.exp(np.polyval(c, np.log(t[m]))), "C3-", lw=2.5, alpha=0.6,
                       label=f"fit over t - t_c = {w[0]:g}-{end}: slope {alpha:.2f}")
+    # The later regime (since session 38): the slope from the early window's end to the run's end.
+    late, lw = summary.get("late_exponent"), summary.get("late_window_s") or []
+    if late is not None and np.isfinite(late) and len(lw) == 2 and None not in lw:
+        m = keep & (t >= lw[0]) & (t <= lw[1])
+        if m.sum() >= 2:
+            c = np.polyfit(np.log(t[m]), np.log(r[m] * 1e6), 1)
+            ax.loglog(t[m], np.exp(np.polyval(c, np.log(t[m]))), "C1-", lw=2.5, alpha=0.6,
+                      label=f"fit over t - t_c = {lw[0]:g}-{lw[1]:.3g} s: slope {late:.2f}")
     # Where the contact went on growing by stretching the bound membrane (spread's note; docs/model/contact_line.md,
     # "The line held at a node ring"): a dotted line at the time the last node came within h0 of the plane.
     since, t_last, edge = (summary.get(k) for k in ("r_cc_growth_since_contact_nodes_most_m",

@@ -11,7 +11,8 @@
 //   spread.h5/.xmf  mesh, series (every column of series.csv), frames (every output.frame_every_s and at
 //                t = 0.1, 0.35, 0.9 s) with the per-node normal force and pressure, cortex tension (eq. 1)
 //                and stretch; not with output.hdf5 = false
-//   summary.json r_cc_final_m, contact_angle_deg, early_exponent (+ window, contact_onset_s), height_final_m,
+//   summary.json r_cc_final_m, contact_angle_deg, early_exponent (+ window, contact_onset_s), late_exponent
+//                (from the window's end to the run's), height_final_m,
 //                steps, wall_s, mean_cg_iterations, energy balance, warnings (steps that did not resolve the
 //                run), ...
 // A new run removes an earlier run's files from its folder first (a restart continues them).

@@ -144,6 +144,13 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
       fit_exponent(m.ts, m.rs, so.early_from_s, so.early_to_s, used, std::isnan(onset) ? 0.0 : onset);
   int used_run_time = 0;
   const double alpha_run_time = fit_exponent(m.ts, m.rs, so.early_from_s, so.early_to_s, used_run_time);
+  // The later regime: the slope from the early window's end to the rows' end, since the onset as the early
+  // fit counts (the paper: "no clear second power-law regime, but merely a slowing down"; the Cuvelier set's
+  // 20-100 s). NaN (null) with fewer than three rows with contact there.
+  int used_late = 0;
+  const double onset_or_0 = std::isnan(onset) ? 0.0 : onset;
+  const double late_to = m.ts.empty() ? 0.0 : m.ts.back() - onset_or_0;
+  const double alpha_late = fit_exponent(m.ts, m.rs, so.early_to_s, late_to, used_late, onset_or_0);
   // Whether the cell still spreads at the end: r_cc's growth over the last tenth of the series (its last row
   // is the end state's, except in a run stopped between rows).
   const double t_rows = m.ts.empty() ? t : m.ts.back();
@@ -212,6 +219,10 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
       .add("contact_onset_s", onset)
       .add("contact_onset_by", m.onset_by_steps ? "steps" : "rows")
       .add("early_exponent_run_time", alpha_run_time)
+      .add("late_exponent", alpha_late)
+      .add("late_window_s", late_to > so.early_to_s ? std::vector<double>{so.early_to_s, late_to}
+                                                    : std::vector<double>{NAN, NAN})
+      .add("late_window_rows", used_late)
       .add("r_cc_growth_last_tenth", growth)
       .add("contact_nodes_final", near_final)
       .add("contact_nodes_most", m.contact_nodes.most)

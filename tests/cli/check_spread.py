@@ -128,6 +128,21 @@ def main():
         # series.csv holds t with 9 digits: the slope from its rows agrees to ~1e-6
         if s["early_exponent"] is None or abs(s["early_exponent"] - slope) > 1e-4:
             fail(f"summary.json early_exponent = {s['early_exponent']}, the rows give {slope} from t = {onset} s")
+    # The later regime (session 38): the same slope from the window's end to the last row, null with fewer than
+    # three rows with contact there.
+    if "late_exponent" not in s or "late_window_s" not in s:
+        fail("summary.json has no key late_exponent or late_window_s")
+    late = [(math.log(t[k] - onset), math.log(rc[k])) for k in range(len(t))
+            if onset is not None and t[k] - onset >= w[1] and t[k] > onset and rc[k] > 0]
+    if not interrupted:
+        if len(late) >= 3:
+            n, sx, sy = len(late), sum(p[0] for p in late), sum(p[1] for p in late)
+            sxx, sxy = sum(p[0] ** 2 for p in late), sum(p[0] * p[1] for p in late)
+            slope = (n * sxy - sx * sy) / (n * sxx - sx * sx)
+            if s["late_exponent"] is None or abs(s["late_exponent"] - slope) > 1e-4:
+                fail(f"summary.json late_exponent = {s['late_exponent']}, the rows give {slope} after {w[1]} s")
+        elif len(late) == 0 and s["late_exponent"] is not None:
+            fail(f"summary.json late_exponent = {s['late_exponent']} without rows after the early window")
     # The window's end the rows reach: null unless the last row lies inside the window (counted from the onset).
     reach = None if onset is None or not t else t[-1] - onset
     cut = s.get("early_window_cut_at_s", "absent")
