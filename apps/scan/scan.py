@@ -34,7 +34,7 @@ PHYSICS = 29
 # it copies this file into the build. The environment variable DCM_SCAN_DEVICE_BUILD (0 or 1) overrides it.
 DEVICE_BUILD = False  # set by the build
 SUMMARY_KEYS = ["r_cc_final_m", "contact_angle_deg", "contact_angle_free_deg", "early_exponent", "contact_onset_s",
-                "r_cc_growth_last_tenth", "r_cc_growth_since_contact_nodes_most_m", "mesh_edge_mean_m",
+                "late_exponent", "r_cc_growth_last_tenth", "r_cc_growth_since_contact_nodes_most_m", "mesh_edge_mean_m",
                 "height_final_m", "steps", "wall_s", "mean_cg_iterations"]
 
 
