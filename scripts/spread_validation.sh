@@ -3,6 +3,7 @@
 # for the mesh comparison and one run per direction of the paper's Figure 5, with the paper's model and with
 # dcm's contact-line setting, in two queues of one thread each (2 cores). Output: out/validation/<run>/ (each a spread output folder) and
 # out/validation/report.md (scripts/spread_report.py: each claim of the paper, measured, and whether it holds;
+# scripts/plot_validation.py draws the curves beside it, curves.png and cuvelier.png per setting;
 # with QUEUE 1 or 2 the other queue's folders, possibly of older code, are judged too).
 # Takes about 20 minutes on 2 cores (session 16: 20.4 min; session 27: see docs/VALIDATION.md).
 # (The full paper scenes: build/bin/spread scenes/<scene>.toml.)
@@ -109,3 +110,5 @@ esac
 py=$(command -v /usr/bin/python3 || command -v python3)  # Debian's, with h5py and numpy (scripts/deps.sh)
 "$py" scripts/spread_report.py "$out" > "$out/report.md.tmp" && mv "$out/report.md.tmp" "$out/report.md"
 echo "wrote $out/report.md: $(tail -n 1 "$out/report.md")"
+# The curves behind the claims, a page per setting (<prefix>curves.png, <prefix>cuvelier.png; session 38).
+"$py" scripts/plot_validation.py "$out"

@@ -2,7 +2,8 @@
 """scripts/spread_report.py judges each claim from the runs' files: a fixture of synthetic runs (power laws of
 known exponent, summaries of known angles and heights) in WORK_DIR, two claims made to fail on purpose, one
 run left out, one run stopped before its end and a small negative change; the report's verdicts must be
-exactly the expected ones (the contact-line setting's continued run still spreads: its at-rest claim fails).
+exactly the expected ones (the contact-line setting's continued run still spreads: its at-rest claim fails);
+scripts/plot_validation.py must draw the pages those runs allow.
 
 usage: check_spread_report.py SOURCE_DIR WORK_DIR
 """
@@ -149,6 +150,19 @@ def main():
                  "α = 0.520 over 0.01–0.095 s (the run's end; the window to 0.1 s)"):
         if must not in out.stdout:
             bad.append(f"not in the report: {must}")
+    # scripts/plot_validation.py on the same runs: a page of curves per setting with runs, the Cuvelier plot
+    # where that run finished (the paper's model; the contact-line one was stopped), none for the crease setting.
+    plots = subprocess.run([sys.executable, os.path.join(src, "scripts", "plot_validation.py"), "--quiet", work],
+                           capture_output=True, text=True)
+    print(plots.stdout, plots.stderr)
+    want = {"curves.png": True, "cuvelier.png": True, "cl_curves.png": True, "cl_cuvelier.png": False,
+            "clc_curves.png": False}
+    if plots.returncode != 0:
+        bad.append(f"plot_validation.py: exit status {plots.returncode}")
+    for png, present in want.items():
+        path = os.path.join(work, png)
+        if os.path.isfile(path) != present or (present and os.path.getsize(path) < 10000):
+            bad.append(f"plot_validation.py: {png} {'missing or empty' if present else 'written'}")
     # A Cuvelier run that keeps its early power law to the end does not slow down (the claim fails), and one
     # from before session 38 (no late_exponent) is not judged.
     for late, want in ((0.5, "**no**"), (None, "a run before session 38")):
