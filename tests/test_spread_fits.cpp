@@ -177,7 +177,7 @@ TEST(SpreadFits, TheOnsetTrackerFindsTheStepThatMadeContact) {
     for (int k = from; k <= to; ++k) {
       const double t = 1e-3 * k;
       if (k > 0 && k % every == 0) tr.row(t, contact(t));
-      if (!tr.in_contact) tr.see(t, contact(t));
+      if (!tr.in_contact || tr.refining) tr.see(t, contact(t) ? 1.0 : 0.0);
     }
   };
   OnsetTracker none;
@@ -221,6 +221,47 @@ TEST(SpreadFits, TheOnsetTrackerFindsTheStepThatMadeContact) {
   EXPECT_DOUBLE_EQ(d.onset, 0.041);
   d.row(0.075, true);
   EXPECT_DOUBLE_EQ(d.onset, 0.070);
+}
+
+// Since session 38 the onset is placed inside the step that made the contact: the first two states with
+// contact extrapolate the area, which grows linearly as the first spheres press in, back to zero, clamped to
+// the step. Steps of 1 ms; the area grows as t − 41.2 ms from 41.2 ms.
+TEST(SpreadFits, TheOnsetTrackerPlacesTheOnsetInsideTheStep) {
+  using dcm::spread_fits::OnsetTracker;
+  const auto run = [](OnsetTracker& tr, int from, int to, int every, const auto& area) {
+    for (int k = from; k <= to; ++k) {
+      const double t = 1e-3 * k;
+      if (k > 0 && k % every == 0) tr.row(t, area(t) > 0);
+      if (!tr.in_contact || tr.refining) tr.see(t, area(t));
+    }
+  };
+  const auto linear = [](double t) { return std::max(0.0, t - 0.0412) * 1e-9; };
+  OnsetTracker a;  // rows every 5 ms: the run's first row (45 ms) comes after the refinement (43 ms)
+  run(a, 0, 60, 5, linear);
+  EXPECT_NEAR(a.onset, 0.0412, 1e-12);
+  OnsetTracker b;  // a row at every step: the run's first row (42 ms) comes before it, and the onset moves
+  run(b, 0, 60, 1, linear);
+  EXPECT_NEAR(b.onset, 0.0412, 1e-12);
+  // An area that grows too slowly for the step (extrapolated to 32 ms) is clamped to the step's start.
+  OnsetTracker c;
+  run(c, 0, 60, 5, [](double t) { return t < 0.042 - 1e-12 ? 0.0 : 1.0 + 100 * (t - 0.042); });
+  EXPECT_DOUBLE_EQ(c.onset, 0.041);
+  // Saved with the refinement pending and loaded: the next state refines the same way; a checkpoint of
+  // sessions 36-37 (five values) loads without it.
+  OnsetTracker d, e, old;
+  run(d, 0, 42, 1, linear);
+  EXPECT_TRUE(d.refining);
+  ASSERT_EQ(d.save().size(), 8u);
+  for (const double v : d.save()) EXPECT_TRUE(std::isfinite(v));
+  e.load(d.save());
+  run(e, 43, 60, 1, linear);
+  EXPECT_NEAR(e.onset, 0.0412, 1e-12);
+  std::vector<double> five = d.save();
+  five.resize(5);
+  old.load(five);
+  EXPECT_FALSE(old.refining);
+  run(old, 43, 60, 1, linear);
+  EXPECT_DOUBLE_EQ(old.onset, 0.041);
 }
 
 // The final growth: a power law still spreading at the end gives 1 − 0.9^α to within the interpolation

@@ -72,21 +72,40 @@ inline double contact_onset(const std::vector<double>& t, const std::vector<doub
 // first had contact, in the last unbroken run of rows with contact, the same run contact_onset takes from the
 // rows; it is fixed when that run's first row is committed, so contact_onset(rows) ≤ onset < that row's time
 // (a contact seen at a step's start and gone before the next row does not count, as in contact_onset).
+// Since session 38 the onset is placed inside that step: the contact area grows linearly in time as the
+// first triangles' spheres press into the plane (a² = 2Rδ, δ growing at the approach speed), so the first two
+// states with contact, (t1, A1) and (t2, A2), give t1 − A1 (t2 − t1) / (A2 − A1), clamped to the step
+// [t_free, t1]. It matters where the steps before the contact are long: an adaptive run's were 0.77 ms, and
+// its early exponent read 0.516 against 0.502 with the paper's 6-µs steps (docs/VALIDATION.md, session 38).
 struct OnsetTracker {
   double t_free = 0;        // the last time a state without contact was seen (a step's start or a row)
-  double candidate = NAN;   // the start of the step that made the contact the steps see now
+  double candidate = NAN;   // when the contact the steps see now began (inside the step that made it)
   double onset = NAN;       // the onset of the last run of rows with contact; NaN: no row with contact yet
   bool in_contact = false;  // the last state seen had contact (while not, spread shows it every step's start)
-  bool row_contact = false;  // the last row committed had contact
+  bool row_contact = false;              // the last row committed had contact
+  double t_first = NAN, area_first = 0;  // the first state with contact of the contact seen now
+  bool refining = false;                 // that contact's second state is still to come (spread shows it too)
 
-  // The state at time t, the start of a step, has contact or not.
-  void see(double t, bool contact) {
-    if (!contact) {
+  // The state at time t, the start of a step, has the contact area `area` (0: none).
+  void see(double t, double area) {
+    if (!(area > 0)) {
       t_free = t;
       in_contact = false;
+      refining = false;
     } else if (!in_contact) {
       candidate = t_free;
       in_contact = true;
+      t_first = t;
+      area_first = area;
+      refining = t > t_free;
+    } else if (refining && t > t_first) {
+      refining = false;
+      if (area > area_first) {
+        const double t_est = t_first - area_first * (t - t_first) / (area - area_first);
+        const double refined = std::min(t_first, std::max(t_free, t_est));
+        if (row_contact && onset == candidate) onset = refined;  // the run's first row came before this state
+        candidate = refined;
+      }
     }
   }
   // A series row at time t: the first row of a run of rows with contact fixes the onset (the step that made
@@ -95,23 +114,29 @@ struct OnsetTracker {
     if (contact && !row_contact) onset = in_contact ? candidate : t_free;
     if (!contact) {
       in_contact = false;
+      refining = false;
       t_free = std::max(t_free, t);
     }
     row_contact = contact;
   }
   // For a checkpoint, whose values are all finite (scripts/check_outputs_finite.py): a time not known yet
-  // (NaN) is stored as −1.
+  // (NaN) is stored as −1. A checkpoint of sessions 36-37 holds the first five.
   std::vector<double> save() const {
     const auto time = [](double t) { return std::isnan(t) ? -1.0 : t; };
-    return {t_free, time(candidate), time(onset), in_contact ? 1.0 : 0.0, row_contact ? 1.0 : 0.0};
+    return {
+        t_free,        time(candidate), time(onset),         in_contact ? 1.0 : 0.0, row_contact ? 1.0 : 0.0,
+        time(t_first), area_first,      refining ? 1.0 : 0.0};
   }
   void load(const std::vector<double>& v) {
     const auto time = [](double t) { return t < 0 ? NAN : t; };
-    t_free = v[0];
-    candidate = time(v[1]);
-    onset = time(v[2]);
-    in_contact = v[3] != 0;
-    row_contact = v[4] != 0;
+    t_free = v.at(0);
+    candidate = time(v.at(1));
+    onset = time(v.at(2));
+    in_contact = v.at(3) != 0;
+    row_contact = v.at(4) != 0;
+    t_first = v.size() >= 8 ? time(v[5]) : NAN;
+    area_first = v.size() >= 8 ? v[6] : 0.0;
+    refining = v.size() >= 8 && v[7] != 0;
   }
 };
 

@@ -78,10 +78,15 @@ void restore_from_checkpoint(Member& m, Model& model, Stepper& stepper) {
     m.contact_nodes.most = NAN;  // not known: the rows before the restart did not count them
   }
   if (c.arrays.count("app.h_last")) m.h_last = c.scalar("app.h_last");
-  if (c.arrays.count("app.contact_onset"))  // since session 36
-    m.onset.load(c.array("app.contact_onset", 5));
-  else
+  if (c.arrays.count("app.contact_onset")) {                      // since session 36
+    const std::vector<double>& v = c.array("app.contact_onset");  // 5 values (sessions 36-37) or 8
+    if (v.size() != 5 && v.size() != 8)
+      throw IoError(c.origin + ": 'app.contact_onset' holds " + std::to_string(v.size()) +
+                    " values, this spread reads 5 or 8");
+    m.onset.load(v);
+  } else {
     m.onset_by_steps = false;  // the steps before the restart were not watched: the onset from the rows
+  }
   m.frames_before = static_cast<int>(c.scalar("app.frames"));
   // A restart may ask for denser rows or frames (output.series_per_decade, output.frame_every_s): the next
   // row and frame then come when the new cadence asks from here, not at the stored times the old cadence
@@ -255,15 +260,17 @@ struct BeforeStep {
   }
 
   // The contact's onset at the steps' resolution (spread_fits::OnsetTracker): every member that has seen no
-  // contact since its last state without it is shown the state at its time now. The contact is the stepper's
+  // contact since its last state without it, or one state with it (the onset is placed inside the step from
+  // the first two), is shown the state at its time now. The contact is the stepper's
   // own, of the positions now (TimeStepper::step calls this after its last compute_forces(); until session 37
   // spread evaluated it again here, a contact pass per step until the first contact).
   void watch_onsets() {
     std::vector<double> area;
     for (Member& m : ms) {
-      if (m.done || cap[m.cell] == 0 || !m.onset_by_steps || m.onset.in_contact) continue;
+      if (m.done || cap[m.cell] == 0 || !m.onset_by_steps || (m.onset.in_contact && !m.onset.refining))
+        continue;
       if (area.empty()) model.contact_area(&area);
-      m.onset.see(stepper.time(m.cell), area[m.cell] > 0);
+      m.onset.see(stepper.time(m.cell), area[m.cell]);
     }
   }
 
