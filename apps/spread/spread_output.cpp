@@ -140,15 +140,14 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   // session 34).
   const double onset_rows = contact_onset(m.ts, m.rs);
   const double onset = m.onset_by_steps ? m.onset.onset : onset_rows;
-  const double alpha =
-      fit_exponent(m.ts, m.rs, so.early_from_s, so.early_to_s, used, std::isnan(onset) ? 0.0 : onset);
+  const double onset_or_0 = std::isnan(onset) ? 0.0 : onset;  // a run that never touched: its own clock
+  const double alpha = fit_exponent(m.ts, m.rs, so.early_from_s, so.early_to_s, used, onset_or_0);
   int used_run_time = 0;
   const double alpha_run_time = fit_exponent(m.ts, m.rs, so.early_from_s, so.early_to_s, used_run_time);
   // The later regime: the slope from the early window's end to the rows' end, since the onset as the early
   // fit counts (the paper: "no clear second power-law regime, but merely a slowing down"; the Cuvelier set's
   // 20-100 s). NaN (null) with fewer than three rows with contact there.
   int used_late = 0;
-  const double onset_or_0 = std::isnan(onset) ? 0.0 : onset;
   const double late_to = m.ts.empty() ? 0.0 : m.ts.back() - onset_or_0;
   const double alpha_late = fit_exponent(m.ts, m.rs, so.early_to_s, late_to, used_late, onset_or_0);
   // Whether the cell still spreads at the end: r_cc's growth over the last tenth of the series (its last row
@@ -282,8 +281,7 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   // slope is that of single triangles touching down (a ratio of radii of ten and more), not a power law.
   double r_start = NAN;  // r_cc at the window's first row with contact
   for (std::size_t i = 0; i < m.ts.size() && i < m.rs.size() && std::isnan(r_start); ++i)
-    if (m.ts[i] - (std::isnan(onset) ? 0.0 : onset) >= so.early_from_s * (1 - 1e-9) && m.rs[i] > 0)
-      r_start = m.rs[i];
+    if (m.ts[i] - onset_or_0 >= so.early_from_s * (1 - 1e-9) && m.rs[i] > 0) r_start = m.rs[i];
   if (!m.options.quiet && std::isfinite(alpha) && r_start < 0.5 * m.edge_mean)
     std::printf(
         "  %snote: the early window opens when the contact is smaller than a triangle (r_cc %.3g um %g s "
