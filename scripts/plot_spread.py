@@ -52,7 +52,9 @@ def plot_rcc(out, s, summary):
     # placed in contact): a cell that needs a while to touch down (the Cuvelier set) shows its power law straight.
     onset = summary.get("contact_onset_s") or 0.0
     t, r = s["t_s"] - onset, s["r_cc_m"]
-    keep = (t > 0) & (r > 0)
+    # rows within the 9-digit rounding of the onset (the first sliver of contact can be the onset's own state,
+    # since session 38) would stretch the log axis over ten decades: kept from 1e-7 of the run's length on
+    keep = (t > 1e-7 * (s["t_s"].max() if len(s["t_s"]) else 0.0)) & (r > 0)
     fig, ax = plt.subplots(figsize=(5.5, 4.2))
     ax.loglog(t[keep], r[keep] * 1e6, "-", color="C0", label="dcm: r_cc(t)")
     if keep.any():

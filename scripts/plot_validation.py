@@ -37,8 +37,9 @@ def curve(run):
         return None
     summary, (t, r) = run
     onset = summary.get("contact_onset_s") or 0.0
-    t, r = np.asarray(t) - onset, np.asarray(r) * 1e6
-    keep = (t > 0) & (r > 0)
+    t_run = np.asarray(t)
+    t, r = t_run - onset, np.asarray(r) * 1e6
+    keep = (t > 1e-7 * (t_run.max() if len(t_run) else 0.0)) & (r > 0)  # not the onset's own 9-digit rounding
     return (t[keep], r[keep]) if keep.any() else None
 
 

@@ -72,7 +72,9 @@ int main(int argc, char** argv) {
   app.add_option(
          "--early-window-s", window,
          "Time window FROM,TO (s) of the early power-law fit, counted, as the fit counts time, from the "
-         "contact's onset (summary.json contact_onset_s) (default 0.01,0.1; a --restart keeps the run's own "
+         "contact's onset (summary.json contact_onset_s) (default: the scene's output.early_window_from_s "
+         "and "
+         "output.early_window_to_s, 0.01,0.1 unless the scene sets them; a --restart keeps the run's own "
          "unless given)")
       ->delimiter(',')
       ->expected(2);

@@ -70,8 +70,10 @@ inline double contact_onset(const std::vector<double>& t, const std::vector<doub
 // contact (see; the stepper calls that point only with the steps before it accepted, so what it sees is never
 // taken back), and every series row it commits (row). Its onset is the start of the step whose end state
 // first had contact, in the last unbroken run of rows with contact, the same run contact_onset takes from the
-// rows; it is fixed when that run's first row is committed, so contact_onset(rows) ≤ onset < that row's time
-// (a contact seen at a step's start and gone before the next row does not count, as in contact_onset).
+// rows; it is set when that run's first row is committed (and moved once more, inside the same step, by the
+// refinement below when that row came before the second state with contact), so contact_onset(rows) ≤ onset
+// ≤ that row's time (a contact seen at a step's start and gone before the next row does not count, as in
+// contact_onset).
 // Since session 38 the onset is placed inside that step: the contact area grows linearly in time as the
 // first triangles' spheres press into the plane (a² = 2Rδ, δ growing at the approach speed), so the first two
 // states with contact, (t1, A1) and (t2, A2), give t1 − A1 (t2 − t1) / (A2 − A1), clamped to the step

@@ -120,16 +120,16 @@ static void set_early_window(Member& m) {
   const char* from_key = "output.early_window_from_s";
   const char* to_key = "output.early_window_to_s";
   if (so.early_window_given) {
-    if (!(so.early_from_s > 0 && so.early_to_s > so.early_from_s))
+    if (!(so.early_from_s > 0 && so.early_to_s > so.early_from_s && so.early_to_s <= 1e6))
       throw SceneError("--early-window-s = " + detail::format_real(so.early_from_s) + "," +
-                       detail::format_real(so.early_to_s) + " is not allowed: need 0 < from < to");
+                       detail::format_real(so.early_to_s) + " is not allowed: need 0 < from < to <= 1e6 (s)");
     scene.set(std::string(from_key) + "=" + detail::format_real(so.early_from_s));
     scene.set(std::string(to_key) + "=" + detail::format_real(so.early_to_s));
-  } else if (m.restart && !scene.was_set(from_key) && !scene.was_set(to_key) &&
-             m.restart->arrays.count("app.early_window_s")) {
+  } else if (m.restart && m.restart->arrays.count("app.early_window_s")) {
+    // a checkpoint's scene without the keys (sessions 28-37): each key not given by --set is the run's own
     const std::vector<double>& w = m.restart->array("app.early_window_s", 2);
-    scene.set(std::string(from_key) + "=" + detail::format_real(w[0]));
-    scene.set(std::string(to_key) + "=" + detail::format_real(w[1]));
+    if (!scene.was_set(from_key)) scene.set(std::string(from_key) + "=" + detail::format_real(w[0]));
+    if (!scene.was_set(to_key)) scene.set(std::string(to_key) + "=" + detail::format_real(w[1]));
   }
   so.early_from_s = scene.get_real(from_key);
   so.early_to_s = scene.get_real(to_key);

@@ -135,14 +135,23 @@ def main():
     late = [(math.log(t[k] - onset), math.log(rc[k])) for k in range(len(t))
             if onset is not None and t[k] - onset >= w[1] and t[k] > onset and rc[k] > 0]
     if not interrupted:
+        lw, reach_end = s["late_window_s"], (None if onset is None or not t else t[-1] - onset)
+        # (a row within 9-digit rounding of the window's start may count either way)
+        edge = sum(1 for k in range(len(t)) if onset is not None and rc[k] > 0 and t[k] > onset
+                   and abs(t[k] - onset - w[1]) <= 1e-8 * max(1.0, t[k]))
+        if not isinstance(s.get("late_window_rows"), int) or abs(s["late_window_rows"] - len(late)) > edge:
+            fail(f"summary.json late_window_rows = {s.get('late_window_rows')}, the rows give {len(late)}")
+        if reach_end is not None and reach_end > w[1] and (
+                lw[0] != w[1] or lw[1] is None or abs(lw[1] - reach_end) > 1e-7 * max(1.0, t[-1])):
+            fail(f"summary.json late_window_s = {lw}, expected [{w[1]}, {reach_end}]")
+        if len(late) < 3 and s["late_exponent"] is not None:
+            fail(f"summary.json late_exponent = {s['late_exponent']} from {len(late)} rows (fewer than three)")
         if len(late) >= 3:
             n, sx, sy = len(late), sum(p[0] for p in late), sum(p[1] for p in late)
             sxx, sxy = sum(p[0] ** 2 for p in late), sum(p[0] * p[1] for p in late)
             slope = (n * sxy - sx * sy) / (n * sxx - sx * sx)
             if s["late_exponent"] is None or abs(s["late_exponent"] - slope) > 1e-4:
                 fail(f"summary.json late_exponent = {s['late_exponent']}, the rows give {slope} after {w[1]} s")
-        elif len(late) == 0 and s["late_exponent"] is not None:
-            fail(f"summary.json late_exponent = {s['late_exponent']} without rows after the early window")
     # The window's end the rows reach: null unless the last row lies inside the window (counted from the onset).
     reach = None if onset is None or not t else t[-1] - onset
     cut = s.get("early_window_cut_at_s", "absent")
