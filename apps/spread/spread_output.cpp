@@ -251,11 +251,15 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
     else
       std::snprintf(exponent, sizeof exponent, "none (%d rows with contact %g-%g s after its onset)", used,
                     so.early_from_s, so.early_to_s);
+    char later[96] = "";  // the later regime's slope, where the rows reach past the early window
+    if (std::isfinite(alpha_late))
+      std::snprintf(later, sizeof later, ", then %.3f over %g-%.4g s", alpha_late, so.early_to_s, late_to);
     std::printf(
-        "  %sr_cc = %.3f um, contact angle %.1f deg (free membrane %.1f), early exponent %s, height %.3f um; "
+        "  %sr_cc = %.3f um, contact angle %.1f deg (free membrane %.1f), early exponent %s%s, height %.3f "
+        "um; "
         "%lld steps in %.1f s, mean CG %.1f\n",
         m.cell > 0 || !m.so.batch.empty() ? (m.out_dir + ": ").c_str() : "", r_final * 1e6, cap.angle_deg,
-        cap_free.angle_deg, exponent, (ztop - m.plane_z) * 1e6, done, wall,
+        cap_free.angle_deg, exponent, later, (ztop - m.plane_z) * 1e6, done, wall,
         done > 0 ? p.cg_total / done : 0.0);
   }
   // Adaptive steps control the position error, not the energy bookkeeping: say when the longest steps left
