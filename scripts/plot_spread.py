@@ -47,6 +47,14 @@ def nearest(frame_list, t):
     return min(frame_list, key=lambda f: abs(f[0] - t))
 
 
+def draw_fit(ax, t, r, mask, color, label):
+    """The least-squares power law through (t, r) over mask, drawn on log-log axes (nothing under two points)."""
+    if mask.sum() < 2:
+        return
+    c = np.polyfit(np.log(t[mask]), np.log(r[mask]), 1)
+    ax.loglog(t[mask], np.exp(np.polyval(c, np.log(t[mask]))), color + "-", lw=2.5, alpha=0.6, label=label)
+
+
 def plot_rcc(out, s, summary):
     # Time counts from the contact's onset (summary.json contact_onset_s, as the early exponent does; 0 for a cell
     # placed in contact): a cell that needs a while to touch down (the Cuvelier set) shows its power law straight.
@@ -67,20 +75,14 @@ def plot_rcc(out, s, summary):
     w = summary.get("early_window_s", [])
     if alpha is not None and np.isfinite(alpha) and len(w) == 2:
         m = keep & (t >= w[0]) & (t <= w[1])  # the window counts from the onset too (since session 36)
-        if m.sum() >= 2:
-            c = np.polyfit(np.log(t[m]), np.log(r[m] * 1e6), 1)
-            cut = summary.get("early_window_cut_at_s")  # the run ended inside the window
-            end = f"{cut:.3g} s (run's end; window to {w[1]:g})" if cut is not None else f"{w[1]:g} s"
-            ax.loglog(t[m], np.exp(np.polyval(c, np.log(t[m]))), "C3-", lw=2.5, alpha=0.6,
-                      label=f"fit over t - t_c = {w[0]:g}-{end}: slope {alpha:.2f}")
+        cut = summary.get("early_window_cut_at_s")  # the run ended inside the window
+        end = f"{cut:.3g} s (run's end; window to {w[1]:g})" if cut is not None else f"{w[1]:g} s"
+        draw_fit(ax, t, r * 1e6, m, "C3", f"fit over t - t_c = {w[0]:g}-{end}: slope {alpha:.2f}")
     # The later regime (since session 38): the slope from the early window's end to the run's end.
     late, lw = summary.get("late_exponent"), summary.get("late_window_s") or []
     if late is not None and np.isfinite(late) and len(lw) == 2 and None not in lw:
         m = keep & (t >= lw[0]) & (t <= lw[1])
-        if m.sum() >= 2:
-            c = np.polyfit(np.log(t[m]), np.log(r[m] * 1e6), 1)
-            ax.loglog(t[m], np.exp(np.polyval(c, np.log(t[m]))), "C1-", lw=2.5, alpha=0.6,
-                      label=f"fit over t - t_c = {lw[0]:g}-{lw[1]:.3g} s: slope {late:.2f}")
+        draw_fit(ax, t, r * 1e6, m, "C1", f"fit over t - t_c = {lw[0]:g}-{lw[1]:.3g} s: slope {late:.2f}")
     # Where the contact went on growing by stretching the bound membrane (spread's note; docs/model/contact_line.md,
     # "The line held at a node ring"): a dotted line at the time the last node came within h0 of the plane.
     since, t_last, edge = (summary.get(k) for k in ("r_cc_growth_since_contact_nodes_most_m",

@@ -29,6 +29,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import spread_report  # noqa: E402  (the runs' names per setting and the loader)
+from plot_spread import draw_fit  # noqa: E402  (the fitted power law, as r_cc.png draws it)
 
 
 def curve(run):
@@ -119,10 +120,7 @@ def plot_setting(folder, setting, prefix):
             if slope is None or not window or None in window:
                 continue
             m = (c[0] >= window[0]) & (c[0] <= window[1])
-            if m.sum() >= 2:
-                fit = np.polyfit(np.log(c[0][m]), np.log(c[1][m]), 1)
-                ax.loglog(c[0][m], np.exp(np.polyval(fit, np.log(c[0][m]))), color + "-", lw=2.5, alpha=0.6,
-                          label=f"{window[0]:g}–{window[1]:.3g} s: slope {slope:.2f}")
+            draw_fit(ax, c[0], c[1], m, color, f"{window[0]:g}–{window[1]:.3g} s: slope {slope:.2f}")
         ax.legend(fontsize=7)
         fig.tight_layout()
         path = os.path.join(folder, prefix + "cuvelier.png")
