@@ -462,7 +462,19 @@ void Scene::set(const std::string& key_equals_value) {
   const std::string key = trim(key_equals_value.substr(0, eq));
   const ParamSpec* spec = find_spec(key);
   if (!spec) fail(kSetOrigin, unknown_key_message(key));
-  assign(key, canonical_from_text(*spec, trim(key_equals_value.substr(eq + 1)), kSetOrigin), true);
+  const std::string canonical = canonical_from_text(*spec, trim(key_equals_value.substr(eq + 1)), kSetOrigin);
+  if (key == kNodes || key == kSubdivisions) {
+    // Two --set of the mesh size must agree, as the two keys in one file must; a --set of one of them
+    // overrides what a file gave (the other follows it).
+    if (!mesh_size_by_set_.empty() && mesh_size_by_set_ != key) {
+      const bool nodes_now = key == kNodes;
+      const long long value = std::strtoll(canonical.c_str(), nullptr, 10);
+      check_mesh_size_pair(nodes_now ? value : get_int(kNodes), nodes_now ? get_int(kSubdivisions) : value,
+                           kSetOrigin);
+    }
+    mesh_size_by_set_ = key;
+  }
+  assign(key, canonical, true);
   if (key == kNodes || key == kSubdivisions) follow_mesh_size(key);
 }
 

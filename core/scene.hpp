@@ -70,6 +70,7 @@ class Scene {
   std::string origin_ = "defaults";
   std::map<std::string, std::string> values_;  // key -> canonical value text
   std::map<std::string, bool> set_;
+  std::string mesh_size_by_set_;  // mesh.nodes or mesh.subdivisions, when set() gave it (empty: neither)
 
   // Stores a checked canonical value; "name" also updates name_ (empty: the name from origin_).
   void assign(const std::string& key, const std::string& canonical, bool given);

@@ -78,8 +78,8 @@ std::vector<ParamSpec> make_schema() {
   return {
       string_key(
           "name", "", {},
-          "run name; output goes to out/<name> unless output.dir is set (empty: the scene file's stem, or "
-          "default without a scene file)"),
+          "run name; output goes to out/<name> unless output.dir is set (empty: the scene file's stem; "
+          "without a scene file the app's name: spread, stretch, relax, or default for geometry)"),
 
       string_key("mesh.shape", "sphere", {"sphere", "evans_fung"},
                  "sphere = icosphere of radius mesh.radius_m; evans_fung = Evans–Fung biconcave RBC of "
@@ -183,7 +183,10 @@ std::vector<ParamSpec> make_schema() {
           "edge stores W ρ |e| tan(turn/2) per wing, the adhesion a sharp fold loses against the fillet "
           "(kernels/contact_crease.hpp; √(√3 k_b/4W) = 1.02e-8 m for Table 1; 0: off)"),
 
-      real_key("time.dt_s", "6e-6", 0, 1, kExcl, "s", "time step (with time.adaptive: the first step)"),
+      real_key(
+          "time.dt_s", "6e-6", 0, 1, kExcl, "s",
+          "time step (with time.adaptive: the first step); fixed steps land on time.t_end_s, the last one "
+          "up to 1.5 dt long"),
       real_key("time.t_end_s", "1.2", 0, 1e6, kExcl, "s",
                "simulated time (spread; relax runs for --duration-s, stretch to equilibrium)"),
       bool_key("time.adaptive", "false",

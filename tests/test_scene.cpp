@@ -399,13 +399,32 @@ TEST(SceneMeshSize, SetOverridesTheOther) {
   EXPECT_EQ(s.get_int("mesh.nodes"), 10242);
   EXPECT_TRUE(s.was_set("mesh.subdivisions"));
   EXPECT_FALSE(s.was_set("mesh.nodes"));
-  s.set("mesh.nodes = 42");
+  s.set("mesh.subdivisions=1");  // the same key again: the last one counts
+  EXPECT_EQ(s.get_int("mesh.nodes"), 42);
+  s.set("mesh.nodes = 42");  // the other key, agreeing
   EXPECT_EQ(s.get_int("mesh.subdivisions"), 1);
   EXPECT_EQ(s.get_int("mesh.nodes"), 42);
   EXPECT_TRUE(s.was_set("mesh.nodes"));
   EXPECT_FALSE(s.was_set("mesh.subdivisions"));
   // The result serialises to a consistent file.
   expect_same_values(Scene::from_string(s.to_toml(), "t.toml"), s);
+}
+
+// Two --set of the mesh size that disagree are refused, as the two keys in one file are (a user's
+// `--set mesh.nodes=642 --set mesh.subdivisions=2` ran 162 nodes until session 39).
+TEST(SceneMeshSize, TwoSetsMustAgree) {
+  Scene s = Scene::defaults();
+  s.set("mesh.nodes=642");
+  try {
+    s.set("mesh.subdivisions=2");
+    FAIL() << "no error";
+  } catch (const SceneError& e) {
+    const std::string msg = e.what();
+    expect_one_line(msg);
+    EXPECT_TRUE(contains(msg, "mesh.nodes = 642 and mesh.subdivisions = 2 disagree")) << msg;
+  }
+  EXPECT_EQ(s.get_int("mesh.nodes"), 642);  // a refused set changes nothing
+  EXPECT_EQ(s.get_int("mesh.subdivisions"), 3);
 }
 
 // ---- set() ---------------------------------------------------------------------------------------

@@ -8,11 +8,13 @@
 
 namespace dcm {
 
-void add_common_options(CLI::App& app, AppOptions& o, const std::vector<std::string>& examples) {
+void add_common_options(CLI::App& app, AppOptions& o, const std::vector<std::string>& examples,
+                        bool interruptible) {
   std::string footer = "Examples:\n";
   for (const std::string& e : examples) footer += "  " + app.get_name() + (e.empty() ? "" : " ") + e + "\n";
-  app.footer(footer +
-             "Exit codes: 0 success, 2 bad input (nothing written), 3 numerical failure, 1 internal error.\n"
+  app.footer(footer + "Exit codes: 0 success, 2 bad input (nothing written), 3 numerical failure, " +
+             std::string(interruptible ? "130 interrupted (Ctrl-C; what was done is kept), " : "") +
+             "1 internal error.\n"
              "Scene keys: --list-keys or docs/SCENES.md.");
   app.add_option("scene", o.scene_path, "Scene file (TOML); without one the built-in defaults run")
       ->check(CLI::ExistingFile);

@@ -33,7 +33,9 @@ struct AppOptions {
 
 // Registers the shared options and the help's footer; `examples` are the app's own command lines
 // (without the app's name), shown under "Examples:".
-void add_common_options(CLI::App& app, AppOptions& options, const std::vector<std::string>& examples);
+// interruptible: the app stops cleanly on Ctrl-C with exit code 130 (spread), which the footer then lists.
+void add_common_options(CLI::App& app, AppOptions& options, const std::vector<std::string>& examples,
+                        bool interruptible = false);
 
 // For --check: when it was given, prints "<app>: scene <name>: ok (checked, nothing written)" (unless
 // --quiet) and returns true; the app then returns before creating its output folder.

@@ -95,6 +95,8 @@ def sweep_values(key, spec):
             values = [math.exp(a + (b - a) * i / (num - 1)) for i in range(num)]
         else:
             values = [start + (stop - start) * i / (num - 1) for i in range(num)]
+        if num > 1:  # the ends are start and stop themselves, the rest to 12 digits (no 0.0020000000000000005)
+            values = [start] + [float(f"{v:.12g}") for v in values[1:-1]] + [stop]
         if isinstance(spec["start"], int) and isinstance(spec["stop"], int):  # an integer key (mesh.nodes, ...)
             if any(v != round(v) for v in values):
                 raise ScanError(f"sweep.{key} = {spec}: integer start and stop give values that are not whole "

@@ -65,7 +65,8 @@ int main(int argc, char** argv) {
       app, options,
       {"scenes/default.toml", "scenes/hategan2004_sphered.toml --out out/hategan",
        "scenes/hategan2004_biconcave.toml --set mesh.nodes=642 --set time.adaptive=true --out out/bic642",
-       "--restart out/hategan/checkpoint.h5 --set time.t_end_s=4"});
+       "--restart out/hategan/checkpoint.h5 --set time.t_end_s=4"},
+      true);
   app.add_flag(
       "--no-plot", [&](std::int64_t) { so.plot = false; }, "Do not write the PNG plots");
   std::vector<double> window;

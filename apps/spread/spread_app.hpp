@@ -134,6 +134,10 @@ struct Member {
   double t = 0, h_cap = 0, e0 = 0, pc = 0, dis = 0;
   long long index = 0;
   bool sample = false;
+  // The step a stop (Ctrl-C, --max-steps) ends on is sampled, so that series.csv reaches the state
+  // summary.json reports; its row goes into the stopped run's series only, not into its checkpoint, and moves
+  // no sample time, so that a continuation writes the rows of an uninterrupted run.
+  bool stop_sample = false;
 };
 
 inline const std::vector<double> kFigureTimes = {0.1, 0.35, 0.9};  // paper Figures 1 and 6

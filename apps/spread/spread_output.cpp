@@ -72,7 +72,8 @@ void write_checkpoint_now(Member& m, const Model& model, const Stepper& stepper,
   c.put("app.height_m", m.heights);
   c.put_text("app.series_csv", m.csv_text);
   c.put("app.series_rows", m.series_rows);
-  c.put("app.pending_row", m.pending_row);
+  // a stop's own row (Member::stop_sample) is not the continuation's
+  c.put("app.pending_row", m.stop_sample ? std::vector<double>{} : m.pending_row);
   c.put("app.contact_nodes", std::vector<double>{m.contact_nodes.most, m.contact_nodes.t, m.contact_nodes.r});
   c.put("app.h_last", m.h_last);
   if (m.onset_by_steps) c.put("app.contact_onset", m.onset.save());
@@ -241,13 +242,18 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   summary.write(m.out_dir + "/summary.json");
   if (!m.options.quiet) {
     // No exponent (null in summary.json) when fewer than three series rows with contact lie in the window.
-    char exponent[160];
-    if (std::isfinite(alpha) && onset > 0)
-      std::snprintf(exponent, sizeof exponent, "%.3f over %g-%g s after the contact at %.4g s", alpha,
-                    so.early_from_s, so.early_to_s, onset);
-    else if (std::isfinite(alpha))
-      std::snprintf(exponent, sizeof exponent, "%.3f over t = %g-%g s", alpha, so.early_from_s,
+    char exponent[200];
+    char window_end[64];  // where the rows end inside the window (a run stopped or ended early), else its end
+    if (std::isfinite(window_cut_at))
+      std::snprintf(window_end, sizeof window_end, "%.4g s (the rows' end; window to %g s)", window_cut_at,
                     so.early_to_s);
+    else
+      std::snprintf(window_end, sizeof window_end, "%g s", so.early_to_s);
+    if (std::isfinite(alpha) && onset > 0)
+      std::snprintf(exponent, sizeof exponent, "%.3f over %g-%s after the contact at %.4g s", alpha,
+                    so.early_from_s, window_end, onset);
+    else if (std::isfinite(alpha))
+      std::snprintf(exponent, sizeof exponent, "%.3f over t = %g-%s", alpha, so.early_from_s, window_end);
     else
       std::snprintf(exponent, sizeof exponent, "none (%d rows with contact %g-%g s after its onset)", used,
                     so.early_from_s, so.early_to_s);
@@ -294,8 +300,9 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
         m.cell > 0 || !m.so.batch.empty() ? (m.out_dir + ": ").c_str() : "", r_start * 1e6, so.early_from_s,
         m.edge_mean * 1e6);
   // A cell still spreading at the end (r_cc up by 1% or more over the last tenth of the run; one still on
-  // t^(1/2) gives 5%): its final values are not the spread-out cell's.
-  if (!m.options.quiet && growth >= 0.01)
+  // t^(1/2) gives 5%): its final values are not the spread-out cell's. Not said of a run stopped before its
+  // t_end (Ctrl-C, --max-steps): it is told to continue to that t_end instead.
+  if (!m.options.quiet && growth >= 0.01 && !m.interrupted && !m.stopped_at_max_steps)
     std::printf(
         "  %snote: r_cc grew %.1f%% over the last tenth of the run (t = %.3g-%.3g s): the cell is still "
         "spreading, the final values are not those of the spread-out cell; continue with spread --restart "

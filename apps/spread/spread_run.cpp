@@ -10,6 +10,14 @@ volatile std::sig_atomic_t g_stop = 0;
 namespace {
 extern "C" void on_signal(int) { g_stop = 1; }
 
+// A time for a message: 9 significant digits (the sum of 0.02-s steps reads 0.034908, not
+// 0.03490799999999795).
+std::string short_time(double t) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", t);
+  return text;
+}
+
 // Each member's output folder and file names; earlier outputs removed only once every member's folder is
 // there, so that a refused batch removes nothing.
 void prepare_output_folders(std::vector<Member>& ms) {
@@ -26,6 +34,8 @@ void prepare_output_folders(std::vector<Member>& ms) {
       remove_earlier_outputs(
           m.out_dir, {"summary.json", "series.csv", "series.csv.part", "spread.h5", "spread.xmf",
                       "checkpoint.h5", "checkpoint.h5.tmp", "r_cc.png", "cells.png", "side_views.png"});
+    else  // the plots of the run so far would be stale beside the continued data (--no-plot, or stopped)
+      remove_earlier_outputs(m.out_dir, {"r_cc.png", "cells.png", "side_views.png"});
 }
 
 // The model of the members that are still running, each a cell (its rest state from its own mesh).
@@ -139,14 +149,12 @@ void print_banner(const std::vector<Member>& ms, const Stepper& stepper) {
         m.so.restart.c_str(), stepper.time(m.cell), static_cast<long long>(m.p.step), m.scene.name().c_str(),
         m.n, m.t_end, kokkos_description().c_str());
   else
-    std::printf(
-        "dcm spread: scene '%s', %d nodes, %s, t_end = %.3g s; %s\n", m.scene.name().c_str(), m.n,
-        m.steps.adaptive
-            ? ("adaptive steps from dt = " + detail::format_real(m.dt) + " s").c_str()
-            : ("dt = " + detail::format_real(m.dt) + " s (" +
-               std::to_string(static_cast<long long>(std::ceil(m.t_end / m.dt * (1 - 1e-12)))) + " steps)")
-                  .c_str(),
-        m.t_end, kokkos_description().c_str());
+    std::printf("dcm spread: scene '%s', %d nodes, %s, t_end = %.3g s; %s\n", m.scene.name().c_str(), m.n,
+                m.steps.adaptive ? ("adaptive steps from dt = " + detail::format_real(m.dt) + " s").c_str()
+                                 : ("dt = " + detail::format_real(m.dt) + " s (" +
+                                    std::to_string(std::max(1LL, std::llround(m.t_end / m.dt))) + " steps)")
+                                       .c_str(),
+                m.t_end, kokkos_description().c_str());
 }
 
 // Per cell, the cap on the next step (0: the member is not stepping); false when no member runs any more.
@@ -301,6 +309,10 @@ struct BeforeStep {
       // A row when the step ends at or past the next sample time (its row's time is the step's end).
       m.sample = t + h_planned[m.cell] >= p.next_sample * (1 - 1e-12) || m.index < 10 ||
                  h_planned[m.cell] >= m.h_cap || ends_run;
+      const bool stopping =
+          g_stop || (m.so.max_steps > 0 && p.step + 1 >= static_cast<double>(m.so.max_steps));
+      m.stop_sample = !m.sample && stopping;
+      m.sample = m.sample || m.stop_sample;
       any_sample = any_sample || m.sample;
     }
     if (any_sample) {  // each cell's own sums (solvers/cortex_model.hpp): the bits of its run alone
@@ -336,7 +348,7 @@ void record_row(std::vector<Member>& ms, Member& m, const StepReport& r, const A
   m.pending_row = make_row(m, t, h, r.iterations, m.e0, m.pc, m.dis, after);
   // The run's end: the time it was asked to reach, not the rounded sum of its steps.
   if (m.last && std::fabs(t + h - m.t_end) <= 1e-12 * m.t_end) m.pending_row[0] = m.t_end;
-  m.p.next_sample = (t + h) * std::pow(10.0, 1.0 / m.per_decade);
+  if (!m.stop_sample) m.p.next_sample = (t + h) * std::pow(10.0, 1.0 / m.per_decade);
 }
 
 // The step's counts into the member's progress, and its row if it was sampled.
@@ -365,9 +377,11 @@ void print_progress(const std::vector<Member>& ms, const Model& model, const Ste
   if (ms.size() == 1) {
     const Member& m = ms.front();
     const double h = rep[0].h, rate = (m.p.step - m.steps_before) / wall;
-    std::printf("  t = %.4f s  r_cc = %.3f um  dt = %.2g s  CG %d it  %.0f steps/s  ETA %.0f s\n",
-                stepper.time(0), std::sqrt(model.contact_area() / kPi) * 1e6, h, rep[0].iterations, rate,
-                (m.t_end - stepper.time(0)) / h / rate);
+    std::printf(
+        "  t = %.4f s  r_cc = %.3f um  dt = %.2g s  CG %d it (last step, all tries)  %.0f steps/s  ETA %.0f "
+        "s\n",
+        stepper.time(0), std::sqrt(model.contact_area() / kPi) * 1e6, h, rep[0].iterations, rate,
+        (m.t_end - stepper.time(0)) / h / rate);
   } else {
     int running = 0;
     double slowest = 1;
@@ -478,6 +492,12 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
     bool stop_all = false;
     for (Member& m : ms)
       if (!m.done && m.stopped_at_max_steps) stop_all = true;
+    // Ctrl-C during a step that wrote no row: one more step, which does (BeforeStep), so that series.csv ends
+    // on the state the run stops in.
+    bool unsampled = false;
+    for (const Member& m : ms)
+      if (!m.done && !m.last && !m.sample) unsampled = true;
+    if (g_stop && !stop_all && unsampled) continue;
     if (g_stop || stop_all) {
       for (Member& m : ms)
         if (!m.done) m.interrupted = g_stop && !m.last;
@@ -498,13 +518,12 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
   // not kill the process before it exits with 130.
   for (const Member& m : ms)
     if (m.stopped_at_max_steps && !m.options.quiet)
-      std::printf("  stopped after --max-steps %lld at t = %s s; continue with: spread --restart %s\n",
-                  m.so.max_steps, detail::format_real(stepper.time(m.cell)).c_str(),
-                  m.checkpoint_path.c_str());
+      std::printf("  stopped after --max-steps %lld at t = %.9g s; continue with: spread --restart %s\n",
+                  m.so.max_steps, stepper.time(m.cell), m.checkpoint_path.c_str());
   for (const Member& m : ms)
     if (m.interrupted)
-      throw AppInterrupted("interrupted at t = " + detail::format_real(stepper.time(m.cell)) + " s; " +
-                           m.out_dir + "/" + (m.h5 ? "spread.h5, " : "") +
+      throw AppInterrupted("interrupted at t = " + short_time(stepper.time(m.cell)) + " s; " + m.out_dir +
+                           "/" + (m.h5 ? "spread.h5, " : "") +
                            "series.csv and summary.json hold what was done; continue with: spread "
                            "--restart " +
                            m.checkpoint_path);
