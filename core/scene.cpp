@@ -466,13 +466,13 @@ void Scene::set(const std::string& key_equals_value) {
   if (key == kNodes || key == kSubdivisions) {
     // Two --set of the mesh size must agree, as the two keys in one file must; a --set of one of them
     // overrides what a file gave (the other follows it).
-    if (!mesh_size_by_set_.empty() && mesh_size_by_set_ != key) {
-      const bool nodes_now = key == kNodes;
+    const bool nodes_now = key == kNodes;
+    if (nodes_now ? subdivisions_by_set_ : nodes_by_set_) {
       const long long value = std::strtoll(canonical.c_str(), nullptr, 10);
       check_mesh_size_pair(nodes_now ? value : get_int(kNodes), nodes_now ? get_int(kSubdivisions) : value,
                            kSetOrigin);
     }
-    mesh_size_by_set_ = key;
+    (nodes_now ? nodes_by_set_ : subdivisions_by_set_) = true;
   }
   assign(key, canonical, true);
   if (key == kNodes || key == kSubdivisions) follow_mesh_size(key);

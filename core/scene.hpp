@@ -70,7 +70,7 @@ class Scene {
   std::string origin_ = "defaults";
   std::map<std::string, std::string> values_;  // key -> canonical value text
   std::map<std::string, bool> set_;
-  std::string mesh_size_by_set_;  // mesh.nodes or mesh.subdivisions, when set() gave it (empty: neither)
+  bool nodes_by_set_ = false, subdivisions_by_set_ = false;  // mesh.nodes, mesh.subdivisions given by set()
 
   // Stores a checked canonical value; "name" also updates name_ (empty: the name from origin_).
   void assign(const std::string& key, const std::string& canonical, bool given);

@@ -425,6 +425,10 @@ TEST(SceneMeshSize, TwoSetsMustAgree) {
   }
   EXPECT_EQ(s.get_int("mesh.nodes"), 642);  // a refused set changes nothing
   EXPECT_EQ(s.get_int("mesh.subdivisions"), 3);
+  // Agreeing first does not let a later set of the same key drop the other one (found by review).
+  s.set("mesh.subdivisions=3");
+  EXPECT_THROW(s.set("mesh.subdivisions=2"), SceneError);
+  EXPECT_EQ(s.get_int("mesh.nodes"), 642);
 }
 
 // ---- set() ---------------------------------------------------------------------------------------

@@ -247,6 +247,12 @@ struct BeforeStep {
     std::optional<AfterStep> now;  // read once, for every member whose last step was taken again
     for (Member& m : ms) {
       if (m.done || m.pending_row.empty()) continue;
+      // A stop's row in a run that went on (not expected: every member reads the stop once per step, below)
+      // is no row of an uninterrupted run.
+      if (m.stop_sample) {
+        m.pending_row.clear();
+        continue;
+      }
       const double t_now = stepper.time(m.cell);
       if (t_now != m.pending_row[0]) {
         if (!now) {
@@ -284,6 +290,9 @@ struct BeforeStep {
 
   void operator()(const std::vector<double>& h_planned) {
     commit_pending_rows();
+    // Ctrl-C read once for every member (a batch's members decide their rows alike: a signal between two of
+    // them gave one a stop row in a step that was not the last; found by review).
+    const bool interrupted_now = g_stop;
     watch_onsets();
     bool any_sample = false;
     std::optional<FrameData> frame;  // computed once, for every member that writes a frame now
@@ -310,7 +319,7 @@ struct BeforeStep {
       m.sample = t + h_planned[m.cell] >= p.next_sample * (1 - 1e-12) || m.index < 10 ||
                  h_planned[m.cell] >= m.h_cap || ends_run;
       const bool stopping =
-          g_stop || (m.so.max_steps > 0 && p.step + 1 >= static_cast<double>(m.so.max_steps));
+          interrupted_now || (m.so.max_steps > 0 && p.step + 1 >= static_cast<double>(m.so.max_steps));
       m.stop_sample = !m.sample && stopping;
       m.sample = m.sample || m.stop_sample;
       any_sample = any_sample || m.sample;
