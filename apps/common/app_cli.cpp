@@ -16,8 +16,9 @@ void add_common_options(CLI::App& app, AppOptions& o, const std::vector<std::str
              std::string(interruptible ? "130 interrupted (Ctrl-C; what was done is kept), " : "") +
              "1 internal error.\n"
              "Scene keys: --list-keys or docs/SCENES.md.");
-  app.add_option("scene", o.scene_path, "Scene file (TOML); without one the built-in defaults run")
-      ->check(CLI::ExistingFile);
+  // No CLI::ExistingFile check: it ran before the unknown options were reported, so `geometry --nodes 642`
+  // said "File does not exist: 642"; Scene::from_file names a missing file itself.
+  app.add_option("scene", o.scene_path, "Scene file (TOML); without one the built-in defaults run");
   app.add_option("--set", o.sets,
                  "Override a scene key, e.g. --set mesh.nodes=642 --set mesh.shape=evans_fung (repeatable; "
                  "--list-keys shows every key)")

@@ -90,6 +90,8 @@ void run(const Options& o) {
     scene.set(set);
   }
   scene.validate();
+  const dcm::MechanicsParams params =
+      dcm::mechanics_from_scene(scene);  // its checks before any file is touched
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
   if (ec || !std::filesystem::is_directory(o.out))
@@ -97,7 +99,7 @@ void run(const Options& o) {
   dcm::remove_earlier_outputs(o.out,
                               {"summary.json", "profile.csv", "shape.csv", "deflate.h5", "deflate.xmf"});
   const dcm::HostMesh sphere = dcm::cell_mesh_from_scene(scene);
-  dcm::CortexModel<Exec> model(Exec(), {dcm::HostCell(sphere)}, dcm::mechanics_from_scene(scene));
+  dcm::CortexModel<Exec> model(Exec(), {dcm::HostCell(sphere)}, params);
   model.set_flat_bending_rest();
   {
     auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), model.positions());

@@ -65,6 +65,10 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
                      " is out of range: allowed > 0 .. 100");
   check_pulled_fraction(ro.pulled_fraction);
   check_no_plane("relax", scene);
+  // Every check before the output folder is touched (--check included): a refused run leaves an earlier
+  // run's files alone.
+  const MechanicsParams params = mechanics_from_scene(scene);
+  const CgSettings cg = cg_settings_from_scene(scene);
   if (stop_after_check("relax", options, scene)) return;
   const std::string out = prepare_output_dir(options, scene);
   remove_earlier_outputs(
@@ -74,7 +78,7 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
 
   const HostMesh mesh = cell_mesh_from_scene(scene);
   const auto [left, right] = pulled_nodes(mesh, ro.pulled_fraction);
-  CortexModel<Exec> model(Exec(), {HostCell(mesh)}, mechanics_from_scene(scene));
+  CortexModel<Exec> model(Exec(), {HostCell(mesh)}, params);
   const int n = model.mesh().n_nodes;
   const auto [da_rest, dt_rest] = axial_transverse_diameters(to_host_vector(model.positions()));
   const double lambda_inf = da_rest / dt_rest;
@@ -104,7 +108,6 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
   Kokkos::deep_copy(model.external_force(), 0.0);
   const double dt = scene.get_real("time.dt_s");
   const long long steps = std::llround(ro.duration_s / dt);
-  const CgSettings cg = cg_settings_from_scene(scene);
   std::vector<int> tri, node_cell(n, 0);
   for (const Tri& t : mesh.triangles) tri.insert(tri.end(), t.begin(), t.end());
   std::unique_ptr<H5Output> h5;  // none with output.hdf5 = false
@@ -126,9 +129,12 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
     try {
       model.compute_forces();
       r = model.solve_velocity(cg, dt);
-    } catch (const NumericalError& e) {
+    } catch (const NumericalError& e) {  // the steps that were done stay readable, as stretch's forces do
+      csv.close();
+      std::rename((out + "/series.csv.tmp").c_str(), (out + "/series.csv").c_str());
+      if (h5) h5->close();
       throw NumericalError("step " + std::to_string(step) + " (t = " + detail::format_real(t) +
-                           " s): " + e.what());
+                           " s): " + e.what() + "; " + out + "/series.csv holds the steps before it");
     }
     cg_total += r.iterations;
     cg_max = std::max(cg_max, r.iterations);

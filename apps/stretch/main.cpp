@@ -47,6 +47,9 @@ void run(const AppOptions& options, const StretchOptions& so) {
       throw SceneError("--forces-pN = " + detail::format_real(f) + " is out of range: allowed 0 .. 10000");
   check_pulled_fraction(so.pulled_fraction);
   check_no_plane("stretch", scene);
+  // Every check before the output folder is touched (--check included): a refused run leaves an earlier
+  // run's files alone.
+  MechanicsParams params = mechanics_from_scene(scene);
   if (stop_after_check("stretch", options, scene)) return;
   const std::string out = prepare_output_dir(options, scene);
   remove_earlier_outputs(
@@ -56,7 +59,6 @@ void run(const AppOptions& options, const StretchOptions& so) {
 
   const HostMesh mesh = cell_mesh_from_scene(scene);
   const auto [left, right] = pulled_nodes(mesh, so.pulled_fraction);
-  MechanicsParams params = mechanics_from_scene(scene);
   CortexModel<Exec> model(Exec(), {HostCell(mesh)}, params);
   const int n = model.mesh().n_nodes;
   const double edge = mean_edge_length(mesh, build_topology(mesh));
