@@ -90,8 +90,8 @@ void run(const Options& o) {
     scene.set(set);
   }
   scene.validate();
-  const dcm::MechanicsParams params =
-      dcm::mechanics_from_scene(scene);  // its checks before any file is touched
+  // The mechanics' own checks before any file is touched (a refused run leaves an earlier one's files alone).
+  const dcm::MechanicsParams params = dcm::mechanics_from_scene(scene);
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
   if (ec || !std::filesystem::is_directory(o.out))
