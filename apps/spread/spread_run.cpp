@@ -527,8 +527,8 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
   // not kill the process before it exits with 130.
   for (const Member& m : ms)
     if (m.stopped_at_max_steps && !m.options.quiet)
-      std::printf("  stopped after --max-steps %lld at t = %.9g s; continue with: spread --restart %s\n",
-                  m.so.max_steps, stepper.time(m.cell), m.checkpoint_path.c_str());
+      std::printf("  stopped after --max-steps %lld at t = %s s; continue with: spread --restart %s\n",
+                  m.so.max_steps, short_time(stepper.time(m.cell)).c_str(), m.checkpoint_path.c_str());
   for (const Member& m : ms)
     if (m.interrupted)
       throw AppInterrupted("interrupted at t = " + short_time(stepper.time(m.cell)) + " s; " + m.out_dir +
