@@ -1,6 +1,11 @@
 #include "apps/common/app_cli.hpp"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 
@@ -50,16 +55,41 @@ Scene load_scene(const AppOptions& o, const std::vector<std::string>& without_fi
 
 bool stop_after_check(const std::string& app, const AppOptions& o, const Scene& scene) {
   if (!o.check) return false;
+  check_output_dir(output_dir_of(o, scene));
   if (!o.quiet)
     std::printf("%s: scene %s: ok (checked, nothing written)\n", app.c_str(), scene.name().c_str());
   return true;
 }
 
-std::string prepare_output_dir(const AppOptions& o, const Scene& scene) {
-  namespace fs = std::filesystem;
+std::string output_dir_of(const AppOptions& o, const Scene& scene) {
   std::string dir = o.out_dir;
   if (dir.empty()) dir = scene.get_string("output.dir");
   if (dir.empty()) dir = "out/" + scene.name();
+  return dir;
+}
+
+void check_output_dir(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path existing = fs::absolute(dir, ec).lexically_normal();
+  if (ec) throw IoError(dir + ": cannot create the output folder (" + ec.message() + ")");
+  // The folder, else the nearest of its parents that exists: the one a run writes in or creates folders in.
+  while (!fs::exists(existing, ec) && existing.has_parent_path() && existing.parent_path() != existing)
+    existing = existing.parent_path();
+  if (!fs::is_directory(existing, ec))
+    throw IoError(dir + ": cannot create the output folder (" + existing.string() + " is not a folder)");
+  // A probe folder, made and removed at once: what the run's first step there (create a folder or a file)
+  // needs, whoever runs it and whatever the file system (access() says yes to root on /proc).
+  std::string probe = (existing / ".dcm-check-XXXXXX").string();
+  if (!mkdtemp(probe.data()))
+    throw IoError(dir + ": cannot create the output folder (" + existing.string() + ": " +
+                  std::strerror(errno) + ")");
+  fs::remove(probe, ec);
+}
+
+std::string prepare_output_dir(const AppOptions& o, const Scene& scene) {
+  namespace fs = std::filesystem;
+  std::string dir = output_dir_of(o, scene);
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw IoError(dir + ": cannot create the output folder (" + ec.message() + ")");

@@ -37,15 +37,24 @@ struct AppOptions {
 void add_common_options(CLI::App& app, AppOptions& options, const std::vector<std::string>& examples,
                         bool interruptible = false);
 
-// For --check: when it was given, prints "<app>: scene <name>: ok (checked, nothing written)" (unless
-// --quiet) and returns true; the app then returns before creating its output folder.
+// For --check: when it was given, checks the output folder (check_output_dir), prints "<app>: scene <name>:
+// ok (checked, nothing written)" (unless --quiet) and returns true; the app then returns before creating its
+// output folder.
 bool stop_after_check(const std::string& app, const AppOptions& options, const Scene& scene);
 
 // The scene from the file (or the built-in defaults changed by `without_file`, e.g. an app's own
 // experiment), with every --set applied, validated. Throws SceneError.
 Scene load_scene(const AppOptions& options, const std::vector<std::string>& without_file = {});
 
-// --out, else output.dir, else out/<scene name>. Creates it; throws IoError if it cannot be written.
+// The output folder: --out, else output.dir, else out/<scene name>.
+std::string output_dir_of(const AppOptions& options, const Scene& scene);
+
+// For --check: throws IoError (the message a run would give) when a run could not create or write the
+// folder `dir`; leaves nothing behind (a probe folder in it, or in its nearest existing parent, is made and
+// removed).
+void check_output_dir(const std::string& dir);
+
+// output_dir_of(). Creates it; throws IoError if it cannot be written.
 std::string prepare_output_dir(const AppOptions& options, const Scene& scene);
 
 // A new run in a folder that held an earlier one: the files of that run (`names`, the app's outputs) go

@@ -18,7 +18,7 @@ missing: finished members are kept, interrupted ones continue from their checkpo
 Exit codes: 0 all members finished, 1 a member failed otherwise (a crash, a full disk: its spread.log says why),
 2 bad input (nothing written), 3 a member failed numerically, 130 stopped.
 """
-import argparse, csv, hashlib, itertools, json, math, os, random, shutil, signal, subprocess, sys, time
+import argparse, csv, errno, hashlib, itertools, json, math, os, random, shutil, signal, subprocess, sys, tempfile, time
 
 try:
     import tomllib
@@ -388,6 +388,20 @@ def ranks_on_this_machine(comm):
     return comm.Split_type(MPI.COMM_TYPE_SHARED).Get_size()
 
 
+def check_writable(out):
+    """Raises ScanError when the folder `out` could not be created or written: a probe folder is made and removed
+    in it or in its nearest existing parent (nothing is left)."""
+    existing = out
+    while not os.path.exists(existing) and os.path.dirname(existing) != existing:
+        existing = os.path.dirname(existing)
+    try:
+        if not os.path.isdir(existing):
+            raise NotADirectoryError(errno.ENOTDIR, f"{existing} is not a folder")
+        os.rmdir(tempfile.mkdtemp(prefix=".dcm-check-", dir=existing))
+    except OSError as e:
+        raise ScanError(f"--out {out}: cannot write there ({e.strerror})")
+
+
 def prepare(a):
     """Checks the arguments and every member's scene, writes scan.json; returns (scan, out). Raises ScanError."""
     if a.jobs < 0 or a.jobs > 1024:
@@ -397,14 +411,19 @@ def prepare(a):
     if a.threads < 0 or a.threads > 1024:
         raise ScanError(f"--threads = {a.threads} is out of range: allowed 1 .. 1024 (0: cores / members run at once)")
     scan = load_scan(a.scan_file)
-    if a.dry_run:
-        return scan, None
-    for m in scan["members"]:  # every member's scene checked before anything is written
-        r = subprocess.run(spread_cmd(a.spread, scan, m, extra=["--check"]), capture_output=True, text=True)
+    out = os.path.abspath(a.out or os.path.join("out", scan["name"]))
+    check_writable(out)
+    refused = {}
+    for m in scan["members"]:  # every member's scene and folder checked before anything is written
+        r = subprocess.run(spread_cmd(a.spread, scan, m, out_dir=os.path.join(out, "members", m["id"]),
+                                      extra=["--check"]), capture_output=True, text=True)
         if r.returncode != 0:
             msg = (r.stderr.strip().splitlines() or ["spread --check failed"])[-1]
-            raise ScanError(f"member {m['id']} ({m['label']}): {msg}")
-    out = os.path.abspath(a.out or os.path.join("out", scan["name"]))
+            if not a.dry_run:
+                raise ScanError(f"member {m['id']} ({m['label']}): {msg}")
+            refused[m["id"]] = msg
+    if a.dry_run:  # the list, and which members a run would refuse
+        return scan, refused
     try:
         os.makedirs(os.path.join(out, "members"), exist_ok=True)
         with open(os.path.join(out, "scan.json.part"), "w") as f:
@@ -565,7 +584,9 @@ def main():
                     help="OpenMP threads per member (default: cores / members run at once)")
     ap.add_argument("--chunk", type=int, default=1,
                     help="members run as one batch (spread --batch; default 1: each member its own process)")
-    ap.add_argument("--dry-run", action="store_true", help="list the members and their --set arguments, run nothing")
+    ap.add_argument("--dry-run", action="store_true",
+                    help="list the members and their --set arguments and check each (exit 2 if a run would refuse "
+                         "one), run nothing")
     ap.add_argument("--no-plot", action="store_true", help="do not draw r_cc_grid.png (nor sensitivity.png)")
     ap.add_argument("--quiet", action="store_true", help="print only errors")
     ap.add_argument("--spread", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "spread"),
@@ -591,11 +612,16 @@ def main():
     if prepared is None:
         return 2
     scan, out = prepared
-    if a.dry_run:
+    if a.dry_run:  # `out` holds the refused members' messages here
         if rank == 0:
             for m in scan["members"]:
                 print(m["id"], m["label"], " ".join(f"--set {s}" for s in m["sets"]))
-        return 0
+            for mid, msg in out.items():
+                print(f"{PROG}: member {mid}: {msg}", file=sys.stderr)
+            if out:
+                print(f"{PROG}: error: a run would refuse {len(out)} of {len(scan['members'])} members (above)",
+                      file=sys.stderr)
+        return 2 if out else 0
 
     cores = os.cpu_count() or 1
     per_rank_cores = max(1, cores // ranks_on_this_machine(comm))

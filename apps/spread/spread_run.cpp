@@ -18,13 +18,19 @@ std::string short_time(double t) {
   return text;
 }
 
+// A member's output folder: its checkpoint's for a restart, else output_dir_of().
+std::string member_out_dir(const Member& m) {
+  const std::string dir = m.restart
+                              ? std::filesystem::path(m.so.restart).parent_path().lexically_normal().string()
+                              : output_dir_of(m.options, m.scene);
+  return dir.empty() ? "." : dir;
+}
+
 // Each member's output folder and file names; earlier outputs removed only once every member's folder is
 // there, so that a refused batch removes nothing.
 void prepare_output_folders(std::vector<Member>& ms) {
   for (Member& m : ms) {
-    m.out_dir = m.restart ? std::filesystem::path(m.so.restart).parent_path().lexically_normal().string()
-                          : prepare_output_dir(m.options, m.scene);
-    if (m.out_dir.empty()) m.out_dir = ".";
+    m.out_dir = m.restart ? member_out_dir(m) : prepare_output_dir(m.options, m.scene);
     m.checkpoint_path = m.out_dir + "/checkpoint.h5";
     m.wrote_checkpoint = m.restart.has_value();
     m.csv_tmp = m.out_dir + "/series.csv.part";
@@ -452,6 +458,7 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
                        ") cannot share the batch: " + why);
   }
   if (ms.front().so.check) {  // everything above would have stopped a bad run; nothing is written
+    for (const Member& m : ms) check_output_dir(member_out_dir(m));
     for (const Member& m : ms)
       if (!m.options.quiet)
         std::printf("spread: scene %s: ok (checked, nothing written)\n", m.scene.name().c_str());

@@ -14,9 +14,9 @@ sed -e "s#\"../scenes/default.toml\"#\"$src/scenes/default.toml\"#" "$src/scans/
 cat > "$out.spread" <<WRAP
 #!/usr/bin/env bash
 die() { exec "$py" -c "import os, signal; signal.signal(signal.SIG\$1, signal.SIG_DFL); os.kill(os.getpid(), signal.SIG\$1)"; }
+for a in "\$@"; do [ "\$a" = --check ] && exec "$spread" "\$@"; done  # scan's checks (with --out too)
 for a in "\$@"; do
   case "\$a" in
-    --check) exec "$spread" "\$@" ;;
     */members/m001) [ "\$MODE" = crash ] && { echo "stand-in: exit 1" >&2; exit 1; }; [ "\$MODE" = int ] && die INT ;;
     */members/m002) [ "\$MODE" = crash ] && die SEGV ;;
   esac
