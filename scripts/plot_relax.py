@@ -55,6 +55,7 @@ def main():
         right.text(0.02 * t_end, 0.055 * y0, "fit floor (5% of start)", fontsize=7, color="gray")
         right.set_ylim(0.8 * min(min(k[1] for k in keep), 0.05 * y0), 1.2 * y0)
     right.set_xlabel("time after release (s)")
+    right.set_ylabel("(λ − λ∞)/(λ + λ∞), λ = D_A/D_T")
     right.set_title("dotted: t_c = 0.1 and 0.3 s (paper's range)", fontsize=8)
     right.legend(fontsize=8)
     right.grid(alpha=0.3, which="both")

@@ -8,8 +8,11 @@ r_cc.png    contact radius against time on log-log axes with a t^(1/2) guide, th
             (paper Figure 4 style), and a dotted line where the last node came down when the contact grew by
             more than a mesh edge after it (stretching of the bound membrane)
 cells.png   the cell at the frames nearest t = 0.1, 0.35, 0.9 s, coloured by the normal force per node
-            (top) and the cortex tension of eq. 1 (bottom) (paper Figure 6 style); a run that ends before
-            0.9 s shows the frames nearest the same fractions of its own end time, each frame once
+            (top, seen from below the plane, where the contact is) and the cortex tension of eq. 1 (bottom,
+            seen from above) (paper Figure 6 style); a run that ends before 0.9 s shows the frames nearest
+            the same fractions of its own end time (end × 0.1/0.9, 0.35/0.9, 1), each frame once; the
+            colours span the 98th percentile of |value| and the colour bar's arrows say that values beyond it
+            are drawn in its end colours
 side_views.png  side views (x-z) of the cell at the frames nearest t = 0, 0.1, 0.35, 0.9 s and the end
             (paper Figure 1 style)
 cells.png and side_views.png need the frames of spread.h5: a run with output.hdf5 = false gets r_cc.png only.
@@ -116,13 +119,15 @@ def plot_cells(out, h5, tri):
     picks = distinct(fl, times)
     ncol = len(picks)
     fig = plt.figure(figsize=(4 * ncol, 7.5))
-    for row, (field, label, cmap) in enumerate(
-            [("normal_force_N", "normal force (pN)", "coolwarm"),
-             ("cortex_tension_J_per_m2", "cortex tension (µN/m)", "viridis")]):
+    for row, (field, label, cmap, elev) in enumerate(
+            [("normal_force_N", "normal force (pN), adhesion > 0", "coolwarm", -30),
+             ("cortex_tension_J_per_m2", "cortex tension (µN/m), tensile > 0", "viridis", 20)]):
         scale = 1e12 if field == "normal_force_N" else 1e6
         vals = [np.asarray(g[field]) * scale for _, g in picks]
         lim = max(np.percentile(np.abs(v), 98) for v in vals) or 1.0
         vmin, vmax = (-lim, lim) if field == "normal_force_N" else (min(v.min() for v in vals), lim)
+        low, high = min(v.min() for v in vals) < vmin, max(v.max() for v in vals) > vmax
+        extend = "both" if low and high else "min" if low else "max" if high else "neither"
         for col, ((t, g), v) in enumerate(zip(picks, vals)):
             x = np.asarray(g["x"]) * 1e6
             ax = fig.add_subplot(2, ncol, ncol * row + col + 1, projection="3d")
@@ -131,12 +136,12 @@ def plot_cells(out, h5, tri):
                                    antialiased=False)
             surf.set_array(face)
             surf.set_clim(vmin, vmax)
-            ax.view_init(elev=20, azim=-60)
+            ax.view_init(elev=elev, azim=-60)
             ax.set_box_aspect((np.ptp(x[:, 0]), np.ptp(x[:, 1]), max(np.ptp(x[:, 2]), 1e-3)))
-            ax.set_title(f"t = {t:.3f} s", fontsize=9)
+            ax.set_title(f"t = {t:.3f} s" + (", from below" if elev < 0 else ""), fontsize=9)
             ax.set_axis_off()
             if col == ncol - 1:
-                fig.colorbar(surf, ax=ax, shrink=0.6, label=label)
+                fig.colorbar(surf, ax=ax, shrink=0.6, label=label, extend=extend)
     fig.tight_layout()
     fig.savefig(os.path.join(out, "cells.png"), dpi=110)
     plt.close(fig)

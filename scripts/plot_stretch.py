@@ -8,6 +8,7 @@ with Mills et al. 2004 (means and error bars) and Suresh et al. 2005.
 """
 import argparse
 import csv
+import json
 import os
 import sys
 
@@ -59,7 +60,9 @@ def main():
     ax.plot(f, dt, "-", color="C1", lw=2, label="dcm D_T (transverse)")
     ax.set_xlabel("stretching force F (pN)")
     ax.set_ylabel("diameter (µm)")
-    ax.set_title("Optical-tweezers stretch of a red blood cell")
+    summary_path = os.path.join(args.out_dir, "summary.json")
+    nodes = json.load(open(summary_path)).get("nodes", "?") if os.path.exists(summary_path) else "?"
+    ax.set_title(f"Optical-tweezers stretch of a red blood cell, {nodes} nodes")
     ax.legend(fontsize=8, ncol=2)
     ax.grid(alpha=0.3)
     fig.tight_layout()

@@ -33,9 +33,10 @@ PHYSICS = 29
 # Whether spread was built for a GPU (a Kokkos with CUDA, HIP or SYCL): apps/scan/CMakeLists.txt sets it when
 # it copies this file into the build. The environment variable DCM_SCAN_DEVICE_BUILD (0 or 1) overrides it.
 DEVICE_BUILD = False  # set by the build
-SUMMARY_KEYS = ["r_cc_final_m", "contact_angle_deg", "contact_angle_free_deg", "early_exponent", "contact_onset_s",
-                "late_exponent", "r_cc_growth_last_tenth", "r_cc_growth_since_contact_nodes_most_m", "mesh_edge_mean_m",
-                "height_final_m", "steps", "wall_s", "mean_cg_iterations"]
+SUMMARY_KEYS = ["r_cc_final_m", "contact_angle_deg", "contact_angle_free_deg", "early_exponent",
+                "early_window_cut_at_s", "contact_onset_s", "late_exponent", "r_cc_growth_last_tenth",
+                "r_cc_growth_since_contact_nodes_most_m", "mesh_edge_mean_m", "height_final_m", "steps", "wall_s",
+                "mean_cg_iterations"]
 
 
 class ScanError(Exception):
@@ -716,6 +717,17 @@ def main():
             print(f"{PROG}: warning: {len(warned)} member(s) ended with warnings (their steps did not resolve the "
                   f"run; summary.csv column warnings, members/<id>/summary.json): {' '.join(warned[:10])}"
                   f"{' ...' if len(warned) > 10 else ''}", file=sys.stderr)
+        spreading = [r["id"] for r in rows if isinstance(r.get("r_cc_growth_last_tenth"), float)
+                     and r["r_cc_growth_last_tenth"] >= 0.01]
+        if spreading and not a.quiet:
+            print(f"{PROG}: note: {len(spreading)} member(s) still spreading at their end (r_cc grew 1% or more over "
+                  f"the last tenth of the run; summary.csv column r_cc_growth_last_tenth): {' '.join(spreading[:10])}"
+                  f"{' ...' if len(spreading) > 10 else ''}", flush=True)
+        cut = [r["id"] for r in rows if r.get("early_window_cut_at_s") not in ("", None)]
+        if cut and not a.quiet:
+            print(f"{PROG}: note: {len(cut)} member(s) end inside the early window, so their early_exponent is "
+                  f"fitted to part of it (summary.csv column early_window_cut_at_s): {' '.join(cut[:10])}"
+                  f"{' ...' if len(cut) > 10 else ''}", flush=True)
         if stop:
             print(f"{PROG}: stopped; run the same command again to finish the missing members", file=sys.stderr)
             rc = 130

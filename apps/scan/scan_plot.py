@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Draws <scan out>/r_cc_grid.png: one panel per swept key (the paper's Figure 5 layout), r_cc(t) of its
-members on log-log axes with a t^(1/2) guide; one_at_a_time scans add the base member in black. A member
+members on log-log axes against the time since each member's contact began (summary.json contact_onset_s, as
+spread's r_cc.png) with a t^(1/2) guide; one_at_a_time scans add the base member in black. A member
 that did not finish (summary.csv's status: failed, interrupted) is drawn dashed up to where it stopped, marked x
 there, its status in the legend. A
 latin_hypercube scan (every member varies every key) colours all members in each panel by that key's value
@@ -15,12 +16,24 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
 
+def onset(out, mid):
+    """The member's contact onset (summary.json contact_onset_s; 0 when missing), as r_cc.png counts time."""
+    try:
+        with open(os.path.join(out, "members", mid, "summary.json")) as f:
+            return float(json.load(f).get("contact_onset_s") or 0.0)
+    except (OSError, ValueError, TypeError):
+        return 0.0
+
+
 def series(out, mid):
+    """r_cc (µm) against the time since the member's contact began (s), as spread's r_cc.png and its
+    early_exponent count it."""
     t, r = [], []
+    t0 = onset(out, mid)
     try:
         with open(os.path.join(out, "members", mid, "series.csv")) as f:
             for row in csv.DictReader(f):
-                ti, ri = float(row["t_s"]), float(row["r_cc_m"])
+                ti, ri = float(row["t_s"]) - t0, float(row["r_cc_m"])
                 if ti > 0 and ri > 0:
                     t.append(ti)
                     r.append(ri * 1e6)
@@ -74,9 +87,14 @@ def main():
             ax.loglog(ts, [1.0 * (tt / 0.1) ** 0.5 for tt in ts], color="0.6", lw=0.8, ls=":", label="t^1/2")
         all_r = [v for m in members for v in series(out, m["id"])[1]]
         if all_r:  # the first touch-down (r_cc of nanometres) would squash the curves
-            ax.set_ylim(bottom=max(min(all_r), 0.03 * max(all_r)), top=1.3 * max(all_r))
+            bottom = max(min(all_r), 0.03 * max(all_r))
+            ax.set_ylim(bottom=bottom, top=1.3 * max(all_r))
+            shown = [tt for m in members + ([base] if base else []) for tt, rr in zip(*series(out, m["id"]))
+                     if rr >= bottom]
+            if shown:  # and the time axis from where the first curve enters the panel
+                ax.set_xlim(left=min(shown) / 1.5)
         ax.set_title(key + (" (colour: low to high)" if len(members) > 8 else ""), fontsize=9)
-        ax.set_xlabel("t (s)")
+        ax.set_xlabel("t − contact onset (s)")
         ax.set_ylabel("r_cc (µm)")
         ax.legend(fontsize=7)
     for i in range(n, rows * cols):

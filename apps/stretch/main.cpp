@@ -3,9 +3,9 @@
 // ±F/n each, the cell is brought to equilibrium, and the axial and transverse diameters D_A (x extent) and
 // D_T (y extent) are recorded for every force. Writes <out>/series.csv (F_N,DA_m,DT_m,newton_steps,
 // max_residual_force_N), <out>/summary.json,
-// <out>/stretch.h5 (+ .xmf) with one frame per force (the frame's "time" is the force in N: ParaView's time
-// control steps through the forces), and <out>/stretch.png against ../shared/data/stretching when plotting
-// is available.
+// <out>/stretch.h5 (+ .xmf) with one frame per force (the frame's "time" is the force in pN: ParaView's time
+// control steps through the forces and reads them in pN; the series group holds series.csv's columns), and
+// <out>/stretch.png against ../shared/data/stretching when plotting is available.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -117,7 +117,8 @@ void run(const AppOptions& options, const StretchOptions& so) {
     csv << line;
     if (h5) {
       const auto ext_h = to_host_vector(model.external_force());
-      h5->write_frame(f, x.data(), {{"external_force_N", 3, ext_h.data()}});
+      h5->write_frame(f_pN, x.data(), {{"external_force_N", 3, ext_h.data()}});
+      h5->append_series({{"F_N", f}, {"DA_m", da.back()}, {"DT_m", dt.back()}});
     }
   }
   csv.close();
