@@ -309,6 +309,34 @@ class CortexModel {
     return m;
   }
 
+  // For a message (host, on the failure path only): the bond of `cell` nearest its maximum length, as
+  // describe_overstretch() names it with its stretch d / d_max appended; "" without bonds.
+  std::string describe_most_extended_bond(int cell) const {
+    if (!bonds_) return "";
+    const auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh_.x);
+    const auto b = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh_.bond);
+    const auto rest = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bonds_->rest_length);
+    const auto bond_cell = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh_.bond_cell);
+    const double x_max = cell_params_.at(cell).bonds.x_max;
+    int best = -1;
+    double worst = -1;
+    for (int k = 0; k < static_cast<int>(b.extent(0)); ++k) {
+      if (bond_cell(k) != cell) continue;
+      double d2 = 0;
+      for (int dim = 0; dim < 3; ++dim) d2 += std::pow(x(b(k, 1), dim) - x(b(k, 0), dim), 2);
+      const double e = std::sqrt(d2) / (x_max * rest(k));
+      if (!(e <= worst)) {  // (a non-finite length wins)
+        worst = e;
+        best = k;
+      }
+    }
+    if (best < 0) return "";
+    char stretch[48];
+    std::snprintf(stretch, sizeof stretch, "%.6f", worst);
+    return "FENE bond " + std::to_string(best) + ", nodes " + std::to_string(b(best, 0)) + "-" +
+           std::to_string(b(best, 1)) + ", at " + stretch + " of d_max";
+  }
+
   // Power of the contact forces at the current velocity (W); 0 without a plane.
   // per_cell (optional): each cell's value, for these and the contact area and load below.
   double contact_power(std::vector<double>* per_cell = nullptr) const {
@@ -738,7 +766,7 @@ class CortexModel {
     return "FENE bond " + std::to_string(bond) + " (nodes " + std::to_string(b(bond, 0)) + "-" +
            std::to_string(b(bond, 1)) + (mesh_.n_cells > 1 ? ", cell " + std::to_string(cell(bond)) : "") +
            ") reached its maximum length d_max = x_max d* (x_max = " + x_max +
-           "); reduce the time step or the load";
+           "); reduce the load (and, in a run that steps in time, the time step)";
   }
 
   // The per-cell constant tables the kernels read (core/cell_params.hpp).

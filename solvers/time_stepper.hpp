@@ -266,9 +266,10 @@ class TimeStepper {
       for (int c = 0; c < n_; ++c) {
         if (!moving[c] || ext[c] < ext_limit[c]) continue;
         if (rep[c].halvings == settings_.max_halvings)
-          throw NumericalError(which(c) +
-                               "a bond stays at its maximum length d_max even with the time step halved " +
-                               std::to_string(settings_.max_halvings) + " times");
+          throw NumericalError(
+              which(c) + "a bond stays at its maximum length d_max even with the time step halved " +
+              std::to_string(settings_.max_halvings) + " times (" + model.describe_most_extended_bond(c) +
+              "; the forces on the cortex exceed what its bonds hold)");
         over[c] = 1;
         h[c] *= 0.5;
         ++rep[c].halvings;

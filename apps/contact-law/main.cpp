@@ -38,11 +38,14 @@ std::string g(double v) {
 }
 
 bool validate(const Options& o) {
-  bool ok = check(o.E > 0 && std::isfinite(o.E), "--E", o.E, "0 < E, Pa") &&
+  // The scene's ranges (cortex.E_Pa from 1 Pa, contact.W_J_per_m2, contact.h0_m, mesh.radius_m): the law is
+  // solved to full precision there; far outside (E = 1e-300 Pa, h0 = 1e-200 m, W = 1e300 J/m²) its terms
+  // overflow or underflow and it printed inf or empty loads (session 40).
+  bool ok = check(o.E >= 1 && o.E <= 1e9, "--E", o.E, "1 <= E <= 1e9 Pa") &&
             check(o.nu >= 0 && o.nu < 0.5, "--nu", o.nu, "0 <= nu < 0.5") &&
-            check(o.W >= 0 && std::isfinite(o.W), "--W", o.W, "0 <= W, J/m^2") &&
-            check(o.h0 > 0 && std::isfinite(o.h0), "--h0", o.h0, "0 < h0, m") &&
-            check(o.R > 0 && std::isfinite(o.R), "--R", o.R, "0 < R, m");
+            check(o.W >= 0 && o.W <= 1, "--W", o.W, "0 <= W <= 1 J/m^2") &&
+            check(o.h0 >= 1e-12 && o.h0 <= 1e-6, "--h0", o.h0, "1e-12 <= h0 <= 1e-6 m") &&
+            check(o.R >= 1e-9 && o.R <= 1e-3, "--R", o.R, "1e-9 <= R <= 1e-3 m");
   for (const double a : o.a) ok = ok && check(a >= 0 && a <= o.R, "--a", a, "0 <= a <= R = " + g(o.R) + " m");
   for (const double d : o.delta)
     ok = ok && check(std::isfinite(d) && d <= o.R, "--delta", d, "delta <= R = " + g(o.R) + " m");
@@ -92,11 +95,12 @@ int main(int argc, char** argv) {
   app.footer(
       "Example:\n  contact-law --W 1e-3 --h0 20e-9 --R 3.25e-6 --a 1e-7 --a 2e-7 --delta=-5e-9\n"
       "Exit codes: 0 success, 2 bad input (one line on stderr).");
-  app.add_option("--E", o.E, "Young's modulus of the cell cortex (Pa), > 0")->capture_default_str();
+  app.add_option("--E", o.E, "Young's modulus of the cell cortex (Pa), 1 <= E <= 1e9")->capture_default_str();
   app.add_option("--nu", o.nu, "Poisson ratio, 0 <= nu < 0.5")->capture_default_str();
-  app.add_option("--W", o.W, "Work of adhesion (J/m^2), >= 0 (0: Hertz)")->capture_default_str();
-  app.add_option("--h0", o.h0, "Range of the Dugdale stress (m), > 0; sigma0 = W/h0")->capture_default_str();
-  app.add_option("--R", o.R, "Reduced radius of the sphere (m), > 0")->capture_default_str();
+  app.add_option("--W", o.W, "Work of adhesion (J/m^2), 0 <= W <= 1 (0: Hertz)")->capture_default_str();
+  app.add_option("--h0", o.h0, "Range of the Dugdale stress (m), 1e-12 <= h0 <= 1e-6; sigma0 = W/h0")
+      ->capture_default_str();
+  app.add_option("--R", o.R, "Reduced radius of the sphere (m), 1e-9 <= R <= 1e-3")->capture_default_str();
   app.add_option("--a", o.a, "Contact radius (m), 0 <= a <= R (repeatable)")->allow_extra_args(false);
   app.add_option("--delta", o.delta,
                  "Geometric overlap (m), <= R; negative: gap to the plane, no force beyond -h0 (repeatable; "

@@ -185,10 +185,17 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
       .add("max_cg_iterations", cg_max)
       .add("wall_s", wall);
   summary.write(out + "/summary.json");
-  if (!options.quiet)
+  const bool fitted = std::isfinite(tc) && tc > 0;
+  if (!options.quiet && fitted)
     std::printf("  relaxation time t_c = %.4g s; mean CG iterations %.1f (max %d); %.1f s\n", tc,
                 static_cast<double>(cg_total) / (steps + 1), cg_max, wall);
-  if (!options.quiet && y_end_rel > 0.25)
+  if (!fitted)  // (a hold force so small that the held cell is its rest shape: nothing decays; session 40)
+    std::fprintf(stderr,
+                 "relax: warning: no relaxation time could be fitted (relaxation_time_s is null): the held "
+                 "shape's elongation y0 = %.3g does not decay over the run; a larger --hold-force-pN deforms "
+                 "the cell\n",
+                 y0);
+  if (!options.quiet && fitted && y_end_rel > 0.25)
     std::printf(
         "  note: the run ends at y = %.2g y0, before the 5%% the fit goes to: t_c is fitted to the first "
         "%.0f%% of the decay; a longer --duration-s fits it whole\n",

@@ -188,6 +188,47 @@ void prepare_member(Member& m) {
                        "node, " +
                        g3(norm) + " N in norm, needs a tolerance <= " + g3(1e-3 * norm) + " N");
   }
+  // The rounded triangles' radius is capped at 1/geometry.h_min_per_m, meant for flattened regions; a cell
+  // whose own radius reaches it gets spheres smaller than its triangles, in contact 100 um above the plane
+  // (mesh.radius_m = 1e-3 reported r_cc = 482 um after one step, session 40).
+  const double cell_radius = scene.get_string("mesh.shape") == "sphere"
+                                 ? scene.get_real("mesh.radius_m")
+                                 : scene.get_real("mesh.diameter_m") / 2;
+  const double h_min = scene.get_real("geometry.h_min_per_m");
+  if (!(cell_radius * h_min < 0.5))
+    throw SceneError(
+        (scene.get_string("mesh.shape") == "sphere"
+             ? "mesh.radius_m = " + detail::format_real(cell_radius)
+             : "mesh.diameter_m = " + detail::format_real(2 * cell_radius)) +
+        " is too large for geometry.h_min_per_m = " + detail::format_real(h_min) +
+        ": the rounded triangles' radius is capped at 1/h_min = " + detail::format_real(1 / h_min) +
+        " m, which must be at least twice the cell's radius (set geometry.h_min_per_m <= " +
+        detail::format_real(0.5 / cell_radius) + ")");
+  // The paper's law must hold the cell: with a strong adhesion against a soft cortex (W = 1 J/m² with Table
+  // 1's E) the Maugis–Dugdale load stays attractive up to an overlap of the cell's whole radius, and the cell
+  // sank 1.2 um into the plane with exit 0 (session 40). Refused, with the largest W that holds it.
+  if (scene.get_string("contact.law") == "maugis_dugdale") {
+    const double E = scene.get_real("cortex.E_Pa"), nu = scene.get_real("cortex.nu");
+    const auto load_at_full_overlap = [&](double W) {
+      return md_state_from_radius(cell_radius, cell_radius, md_material(E, nu, W, h0)).P;
+    };
+    const double W = scene.get_real("contact.W_J_per_m2");
+    if (!(load_at_full_overlap(W) > 0)) {
+      double lo = 0, hi = W;  // the load at a = R is repulsive at lo, attractive at hi
+      for (int k = 0; k < 100; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (load_at_full_overlap(mid) > 0 ? lo : hi) = mid;
+      }
+      char b[64];
+      std::snprintf(b, sizeof b, "%.3g", lo);
+      throw SceneError("contact.W_J_per_m2 = " + detail::format_real(W) +
+                       " is too strong for this cell: with cortex.E_Pa = " + detail::format_real(E) +
+                       " and contact.h0_m = " + detail::format_real(h0) +
+                       " the Maugis-Dugdale load stays attractive up to an overlap of the cell's radius, so "
+                       "nothing holds the cell on the plane; allowed: below " +
+                       b + " J/m^2 (or a stiffer cortex.E_Pa)");
+    }
+  }
   m.dt = scene.get_real("time.dt_s");
   m.t_end = scene.get_real("time.t_end_s");
   m.steps = steps_from_scene(scene);

@@ -88,7 +88,16 @@ void run(const AppOptions& options, const StretchOptions& so) {
     NewtonSettings ns;
     ns.force_tol = std::max(1e-4 * 200e-12 / left.size(), 1e-17);
     if (const char* trace = std::getenv("DCM_NEWTON_TRACE")) ns.trace = std::atoi(trace);
-    const NewtonResult r = newton_equilibrium(model, ns, edge);
+    NewtonResult r;
+    try {
+      r = newton_equilibrium(model, ns, edge);
+    } catch (const NumericalError& e) {  // the forces that did converge stay, as below (session 40)
+      csv.close();
+      std::rename((out + "/series.csv.tmp").c_str(), (out + "/series.csv").c_str());
+      if (h5) h5->close();
+      throw NumericalError("stretch at F = " + detail::format_real(f_pN) + " pN: " + e.what() +
+                           "; series.csv holds the forces before it");
+    }
     const auto x = to_host_vector(model.positions());
     const auto [d_axial, d_transverse] = axial_transverse_diameters(x);
     if (!options.quiet)
