@@ -95,7 +95,7 @@ std::vector<ParamSpec> make_schema() {
                "lower clamp of the triangle mean curvature H (the rounded triangles' radius is at most "
                "1/H_min)"),
 
-      real_key("cortex.E_Pa", "800e3", 0, 1e9, kExcl, "Pa", "Young's modulus of the cortex (contact law)"),
+      real_key("cortex.E_Pa", "800e3", 1, 1e9, kIncl, "Pa", "Young's modulus of the cortex (contact law)"),
       real_key("cortex.nu", "0.4", 0, 0.5, kIncl, "", "Poisson ratio of the cortex"),
       real_key("cortex.k_s_N_per_m", "3.2e-6", 0, 1, kExcl, "N/m", "FENE+POW spring constant"),
       real_key("cortex.x_max", "2.05", 1, 10, kExcl, "", "maximum bond extension d_max/d*"),
@@ -159,7 +159,7 @@ std::vector<ParamSpec> make_schema() {
                "solver.cg_abs_tol_N below the weight's force norm, which the error message gives; negative: "
                "pressed into the plane)"),
       real_key("contact.W_J_per_m2", "1e-3", 0, 1, kIncl, "J/m²", "work of adhesion"),
-      real_key("contact.h0_m", "20e-9", 0, 1e-6, kExcl, "m", "range of adhesion (Dugdale)"),
+      real_key("contact.h0_m", "20e-9", 1e-12, 1e-6, kIncl, "m", "range of adhesion (Dugdale)"),
       real_key("contact.gamma_n_N_s_per_m3", "8e9", 0, 1e15, kIncl, "N·s/m³", "normal substrate friction"),
       real_key("contact.gamma_t_N_s_per_m3", "6e9", 0, 1e15, kIncl, "N·s/m³",
                "tangential substrate friction"),

@@ -322,3 +322,27 @@ TEST(SpreadFits, MeanEdgeOfATetrahedron) {
   EXPECT_NEAR(dcm::spread_fits::mean_edge_length(x, tri), std::sqrt(8.0), 1e-15);
   EXPECT_TRUE(std::isnan(dcm::spread_fits::mean_edge_length(x, {})));
 }
+
+// Folded nodes (session 40): a contact pressed evenly, however deep, has none; a fold 10 times the bound
+// membrane's depth is counted; nothing below the plane, none.
+TEST(SpreadFits, FoldedNodesAreTheOnesFarBelowTheBoundMembrane) {
+  double median = -1;
+  EXPECT_EQ(dcm::spread_fits::folded_nodes({}, 20e-9, median), 0);
+  EXPECT_EQ(median, 0);
+  std::vector<double> even(500, 31e-9);  // the paper's scene: 31 nm everywhere
+  for (int i = 0; i < 500; ++i) even[i] += 1e-9 * (i % 3);
+  EXPECT_EQ(dcm::spread_fits::folded_nodes(even, 20e-9, median), 0);
+  EXPECT_NEAR(median, 32e-9, 1.1e-9);
+  std::vector<double> deep(500, 0.2e-6);  // W = 0.1 J/m²: 0.18-0.27 um evenly
+  for (int i = 0; i < 500; ++i) deep[i] += 0.07e-6 * (i % 2);
+  EXPECT_EQ(dcm::spread_fits::folded_nodes(deep, 20e-9, median), 0);
+  std::vector<double> shallow(500, 16e-9);  // h0 = 1 nm: 16 nm evenly, 16 h0 deep
+  EXPECT_EQ(dcm::spread_fits::folded_nodes(shallow, 1e-9, median), 0);
+  std::vector<double> fold = even;  // two nodes folded 0.19 and 0.41 um in (the biconcave 642-node rim)
+  fold.push_back(0.19e-6);
+  fold.push_back(0.41e-6);
+  EXPECT_EQ(dcm::spread_fits::folded_nodes(fold, 20e-9, median), 2);
+  std::vector<double> tiny(10, 1e-12);  // a contact barely pressed: a node 10 times deeper is still within h0
+  tiny.push_back(1e-11);
+  EXPECT_EQ(dcm::spread_fits::folded_nodes(tiny, 20e-9, median), 0);
+}

@@ -163,7 +163,9 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
   csv.close();
   std::rename((out + "/series.csv.tmp").c_str(), (out + "/series.csv").c_str());
   if (h5) h5->close();
-  const double tc = fit_relaxation_time(ts, ys, 0.05 * y0);
+  const double tc_fit = fit_relaxation_time(ts, ys, 0.05 * y0);
+  const bool fitted = std::isfinite(tc_fit) && tc_fit > 0;  // (no decay, or a growing y: nothing to report)
+  const double tc = fitted ? tc_fit : NAN;
   // How much of the decay the fit saw: a run that ends before y falls to 5% of y0 fits its first part only (a
   // 0.01-s run of the paper's cell: its first 7%); below three quarters of it, relax says so (the paper's 0.6
   // s ends at about 5%).
@@ -185,7 +187,6 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
       .add("max_cg_iterations", cg_max)
       .add("wall_s", wall);
   summary.write(out + "/summary.json");
-  const bool fitted = std::isfinite(tc) && tc > 0;
   if (!options.quiet && fitted)
     std::printf("  relaxation time t_c = %.4g s; mean CG iterations %.1f (max %d); %.1f s\n", tc,
                 static_cast<double>(cg_total) / (steps + 1), cg_max, wall);

@@ -416,8 +416,12 @@ def prepare(a):
     check_writable(out)
     refused = {}
     for m in scan["members"]:  # every member's scene and folder checked before anything is written
-        r = subprocess.run(spread_cmd(a.spread, scan, m, out_dir=os.path.join(out, "members", m["id"]),
-                                      extra=["--check"]), capture_output=True, text=True)
+        try:
+            r = subprocess.run(spread_cmd(a.spread, scan, m, out_dir=os.path.join(out, "members", m["id"]),
+                                          extra=["--check"]), capture_output=True, text=True)
+        except OSError as e:
+            raise ScanError(f"cannot run spread ({a.spread}): {e.strerror}; run the build's bin/scan, which has "
+                            f"spread beside it")
         if r.returncode != 0:
             msg = (r.stderr.strip().splitlines() or ["spread --check failed"])[-1]
             if not a.dry_run:
@@ -714,8 +718,8 @@ def main():
                   flush=True)
         warned = [r["id"] for r in rows if r.get("warnings") not in ("", 0)]
         if warned:
-            print(f"{PROG}: warning: {len(warned)} member(s) ended with warnings (their steps did not resolve the "
-                  f"run; summary.csv column warnings, members/<id>/summary.json): {' '.join(warned[:10])}"
+            print(f"{PROG}: warning: {len(warned)} member(s) ended with warnings (unresolved steps, or results "
+                  f"outside the model; summary.csv column warnings, members/<id>/summary.json): {' '.join(warned[:10])}"
                   f"{' ...' if len(warned) > 10 else ''}", file=sys.stderr)
         spreading = [r["id"] for r in rows if isinstance(r.get("r_cc_growth_last_tenth"), float)
                      and r["r_cc_growth_last_tenth"] >= 0.01]

@@ -17,12 +17,27 @@ import matplotlib.pyplot as plt
 
 
 def onset(out, mid):
-    """The member's contact onset (summary.json contact_onset_s; 0 when missing), as r_cc.png counts time."""
+    """The member's contact onset, as r_cc.png counts time: summary.json's contact_onset_s; for a member without
+    one (failed, interrupted) the last row without contact before its rows with contact, as spread finds it
+    from the rows; 0 when neither is known."""
     try:
         with open(os.path.join(out, "members", mid, "summary.json")) as f:
-            return float(json.load(f).get("contact_onset_s") or 0.0)
+            value = json.load(f).get("contact_onset_s")
+            if value is not None:
+                return float(value)
     except (OSError, ValueError, TypeError):
+        pass
+    try:
+        with open(os.path.join(out, "members", mid, "series.csv")) as f:
+            rows = [(float(r["t_s"]), float(r["r_cc_m"])) for r in csv.DictReader(f)]
+    except (OSError, ValueError, KeyError):
         return 0.0
+    before = 0.0
+    for t, r in rows:
+        if r > 0:
+            return before
+        before = t
+    return 0.0
 
 
 def series(out, mid):

@@ -181,6 +181,21 @@ inline double final_growth(const std::vector<double>& t, const std::vector<doubl
   return (r[n - 1] - r_from) / r[n - 1];
 }
 
+// Nodes folded into the substrate (session 40): of the nodes below the plane (depth > 0, m), those deeper
+// than 3 times their median depth and than h0. A pressed contact holds the bound membrane evenly at a depth
+// the law sets (31 nm in the paper's scene, 16 nm with h0 = 1 nm, 0.2 um evenly with W = 0.1 J/m²); membrane
+// that buckles or folds over at the rim, where the paper's law pushes back only on triangles facing the
+// plane, reaches 10 times that. median: the median depth (0 without nodes below the plane).
+inline int folded_nodes(std::vector<double> depth, double h0, double& median) {
+  median = 0;
+  if (depth.empty()) return 0;
+  std::nth_element(depth.begin(), depth.begin() + depth.size() / 2, depth.end());
+  median = depth[depth.size() / 2];
+  int n = 0;
+  for (const double d : depth) n += d > 3 * median && d > h0;
+  return n;
+}
+
 // The nodes in range of the plane over a run's series rows (within contact.h0_m of it): the most of them a
 // row has seen, and the time and r_cc of the first row that saw that many. most = NaN: not known (a run
 // continued from a checkpoint of a dcm before session 32).

@@ -221,6 +221,11 @@ void prepare_member(Member& m) {
       }
       char b[64];
       std::snprintf(b, sizeof b, "%.3g", lo);
+      if (!(lo > 0))  // (with the ranges' extremes of E and h0 no adhesion holds the cell)
+        throw SceneError("cortex.E_Pa = " + detail::format_real(E) +
+                         " with contact.h0_m = " + detail::format_real(h0) +
+                         ": the Maugis-Dugdale load stays attractive up to an overlap of the cell's radius "
+                         "for any contact.W_J_per_m2 > 0; a stiffer cortex.E_Pa holds the cell");
       throw SceneError("contact.W_J_per_m2 = " + detail::format_real(W) +
                        " is too strong for this cell: with cortex.E_Pa = " + detail::format_real(E) +
                        " and contact.h0_m = " + detail::format_real(h0) +

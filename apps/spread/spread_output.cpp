@@ -127,13 +127,16 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   const long long done = static_cast<long long>(m.p.step);
   const auto x = model.cell_slice(model.positions(), m.cell);
   double ztop = -INFINITY, zlow = INFINITY;
-  int near_final = 0, deep = 0;  // nodes within h0 of the plane at the end; nodes more than 5 h0 below it
+  int near_final = 0;         // nodes within h0 of the plane at the end
+  std::vector<double> depth;  // how far each node below the plane is
   for (int i = 0; i < m.n; ++i) {
     ztop = std::max(ztop, x[3 * i + 2]);
     zlow = std::min(zlow, x[3 * i + 2]);
     near_final += x[3 * i + 2] - m.plane_z < m.h0;
-    deep += m.plane_z - x[3 * i + 2] > 5 * m.h0;
+    if (x[3 * i + 2] < m.plane_z) depth.push_back(m.plane_z - x[3 * i + 2]);
   }
+  double depth_typical = 0;
+  const int deep = spread_fits::folded_nodes(depth, m.h0, depth_typical);
   const CapFit cap = fit_cap(x, m.plane_z, false), cap_free = fit_cap(x, m.plane_z, true);
   int used = 0;
   const SpreadOptions& so = m.so;
@@ -197,17 +200,16 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   // Results outside what the model can say (session 40, found by probing extreme scenes; each ran to exit 0
   // with an empty warnings list before; a W too strong for the contact law to hold is refused up front,
   // spread_member.cpp):
-  // nodes folded into the substrate (a pressed contact holds the bound membrane about h0 in: 31 nm in the
-  // paper's scene; the paper's law pushes back only on triangles that face the plane, so membrane that
-  // buckles or folds over at the rim can pass into it: 0.34 um with soft area terms and Table 1's bending,
-  // 0.41 um at the biconcave cell's rim on 642 nodes, session 40);
+  // nodes folded into the substrate (the paper's law pushes back only on triangles that face the plane, so
+  // membrane that buckles or folds over at the rim can pass into it: 0.34 um with soft area terms and Table
+  // 1's bending, 0.41 um at the biconcave cell's rim on 642 nodes, session 40);
   if (deep > 0) {
     std::snprintf(text, sizeof text,
-                  "%d node(s) end up to %.3g um below the plane (a pressed contact holds nodes about "
-                  "contact.h0_m in): the membrane folds into the substrate there, which the contact pushes "
-                  "back only where its triangles face the plane; the shape near the contact line is not "
-                  "physical there",
-                  deep, (m.plane_z - zlow) * 1e6);
+                  "%d node(s) end up to %.3g um below the plane, more than 3 times the bound membrane's "
+                  "typical depth (%.3g um): the membrane folds into the substrate there, which the contact "
+                  "pushes back only where its triangles face the plane; the shape near those nodes is not "
+                  "physical",
+                  deep, (m.plane_z - zlow) * 1e6, depth_typical * 1e6);
     warnings.emplace_back(text);
   }
   // no step moved the cell (every CG solve stopped at once: the forces were below the absolute tolerance);
