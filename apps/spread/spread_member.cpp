@@ -160,6 +160,9 @@ void prepare_member(Member& m) {
         "contact.plane = false: spread needs the substrate plane (set contact.plane = true, or leave "
         "the key out)");
   const double h0 = scene.get_real("contact.h0_m"), gap = scene.get_real("contact.start_gap_m");
+  const double cell_radius = scene.get_string("mesh.shape") == "sphere"
+                                 ? scene.get_real("mesh.radius_m")
+                                 : scene.get_real("mesh.diameter_m") / 2;
   const bool falls =
       scene.get_real("body.gravity_m_per_s2") > 0 && scene.get_real("body.density_excess_kg_per_m3") > 0;
   if (!(gap < h0) && !falls)
@@ -171,8 +174,7 @@ void prepare_member(Member& m) {
     // The cell has to sink to the plane. Its weight is spread over the nodes, so the force vector's norm is
     // Δρ V g / √N: the CG's absolute tolerance must lie well below it, or the solve returns v = 0 and the
     // cell hangs in the fluid (the paper's 1e-14 N is larger than a 642-node RBC's weight norm, 4e-15 N).
-    const double r = scene.get_string("mesh.shape") == "sphere" ? scene.get_real("mesh.radius_m")
-                                                                : scene.get_real("mesh.diameter_m") / 2;
+    const double r = cell_radius;
     const double weight = scene.get_real("body.density_excess_kg_per_m3") * 4.0 / 3.0 * kPi * r * r * r *
                           scene.get_real("body.gravity_m_per_s2");
     const double norm = weight / std::sqrt(static_cast<double>(scene.get_int("mesh.nodes")));
@@ -191,9 +193,6 @@ void prepare_member(Member& m) {
   // The rounded triangles' radius is capped at 1/geometry.h_min_per_m, meant for flattened regions; a cell
   // whose own radius reaches it gets spheres smaller than its triangles, in contact 100 um above the plane
   // (mesh.radius_m = 1e-3 reported r_cc = 482 um after one step, session 40).
-  const double cell_radius = scene.get_string("mesh.shape") == "sphere"
-                                 ? scene.get_real("mesh.radius_m")
-                                 : scene.get_real("mesh.diameter_m") / 2;
   const double h_min = scene.get_real("geometry.h_min_per_m");
   if (!(cell_radius * h_min < 0.5))
     throw SceneError(

@@ -88,15 +88,19 @@ void run(const AppOptions& options, const StretchOptions& so) {
     NewtonSettings ns;
     ns.force_tol = std::max(1e-4 * 200e-12 / left.size(), 1e-17);
     if (const char* trace = std::getenv("DCM_NEWTON_TRACE")) ns.trace = std::atoi(trace);
-    NewtonResult r;
-    try {
-      r = newton_equilibrium(model, ns, edge);
-    } catch (const NumericalError& e) {  // the forces that did converge stay, as below (session 40)
+    // A force that fails keeps the forces that did converge (series.csv, stretch.h5), then stops.
+    const auto fail = [&](const std::string& why) {
       csv.close();
       std::rename((out + "/series.csv.tmp").c_str(), (out + "/series.csv").c_str());
       if (h5) h5->close();
-      throw NumericalError("stretch at F = " + detail::format_real(f_pN) + " pN: " + e.what() +
+      throw NumericalError("stretch at F = " + detail::format_real(f_pN) + " pN " + why +
                            "; series.csv holds the forces before it");
+    };
+    NewtonResult r;
+    try {
+      r = newton_equilibrium(model, ns, edge);
+    } catch (const NumericalError& e) {  // (a solve inside that throws: session 40)
+      fail(std::string("failed: ") + e.what());
     }
     const auto x = to_host_vector(model.positions());
     const auto [d_axial, d_transverse] = axial_transverse_diameters(x);
@@ -106,16 +110,11 @@ void run(const AppOptions& options, const StretchOptions& so) {
                   r.converged ? "" : ", NOT CONVERGED");
     std::fflush(stdout);
     if (!r.converged) {
-      csv.close();  // keep the forces that did converge
-      std::rename((out + "/series.csv.tmp").c_str(), (out + "/series.csv").c_str());
-      if (h5) h5->close();
-      char msg[256];
-      std::snprintf(
-          msg, sizeof msg,
-          "stretch at F = %g pN did not reach equilibrium in %d Newton steps (largest node force %.3g N); "
-          "series.csv holds the forces before it",
-          f_pN, r.newton_steps, r.max_force);
-      throw NumericalError(msg);
+      char msg[160];
+      std::snprintf(msg, sizeof msg,
+                    "did not reach equilibrium in %d Newton steps (largest node force %.3g N)",
+                    r.newton_steps, r.max_force);
+      fail(msg);
     }
     forces.push_back(f);
     da.push_back(d_axial);
