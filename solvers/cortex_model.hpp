@@ -30,6 +30,7 @@
 #include "kernels/plane_contact.hpp"
 #include "kernels/volume_constraint.hpp"
 #include "solvers/bending_stiffness.hpp"
+#include "solvers/breakdown_diagnosis.hpp"
 #include "solvers/friction_operator.hpp"
 #include "solvers/global_stiffness.hpp"
 #include "solvers/global_woodbury.hpp"
@@ -456,6 +457,7 @@ class CortexModel {
       if ((h > 0) != with_dt)
         throw std::invalid_argument("solve_velocity: steps must be all positive or all 0");
     dt_.assign(dt_cells);
+    last_solve_implicit_ = with_dt;
     const double dt = with_dt ? 1.0 : 0.0;  // only its sign is used below
     const bool implicit_bonds = dt > 0 && params_.implicit_bonds && bonds_.has_value();
     if (implicit_bonds) {
@@ -574,7 +576,15 @@ class CortexModel {
                            (bad_v >= 0 ? " (the velocity of node " + std::to_string(bad_v) + " first)" : "") +
                            "; the largest force is at node " + std::to_string(largest_force_node()));
     }
-    if (!r.converged && throw_if_unconverged) throw NumericalError(unconverged_message(r, settings));
+    if (!r.converged && throw_if_unconverged) {
+      std::string why = unconverged_message(r, settings);
+      for (int c = 0; c < mesh_.n_cells; ++c)
+        if (cg_.segment_results[c].breakdown) {
+          why += describe_breakdown(c);
+          break;
+        }
+      throw NumericalError(why);
+    }
     const int bad = first_non_finite_node(space_, velocity_);
     if (bad >= 0)
       throw NumericalError("non-finite velocity at node " + std::to_string(bad) + " after the solve");
@@ -607,12 +617,69 @@ class CortexModel {
     return first < mesh_.n_nodes ? first : 0;
   }
 
+  // After a solve that broke down (CgResult::breakdown) the workspace still holds the search direction p
+  // along which p·(Γ + Δt K)p was not positive. Each term of the operator is applied to p alone; the text
+  // gives, for cell `cell`, every term's p·A_term p (W) and names the first that is not positive, with the
+  // node where p_i·(A_term p)_i is lowest (or first not finite). For the messages of a failed step.
+  std::string describe_breakdown(int cell) {
+    const auto p = cg_.p, q = cg_.q, z = cg_.z;
+    const auto node_cell = mesh_.node_cell;
+    std::string text = "; p.A p per term along that direction:";
+    bool named = false, first = true;
+    std::vector<double> dots;
+    const auto term = [&](const char* name, const Vector& aq) {
+      cg_detail::segment_dots(space_, cg_.sums, p, aq, dots, "dcm::model::breakdown_term");
+      const double c = dots[cell];
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%s %s %.3g W", first ? "" : ",", name, c);
+      text += buf;
+      first = false;
+      if (named || c > 0) return;  // !(c > 0): also NaN
+      named = true;
+      bool not_finite = false;
+      const int node = breakdown_node(space_, node_cell, cell, p, aq, not_finite);
+      text += std::string(" (the term at fault: ") +
+              (not_finite ? "not finite first at node " : "lowest at node ") + std::to_string(node) + ")";
+    };
+    FrictionOperator<Mem> gamma = friction_;  // Γ alone, without the implicit bond stiffness
+    gamma.bond_stiffness_dt = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
+    apply_friction(space_, mesh_, gamma, p, q);
+    term("friction (drag, dashpots, substrate)", q);
+    if (last_solve_implicit_ && friction_.bond_stiffness_dt.extent(0) > 0) {
+      apply_friction(space_, mesh_, friction_, p, z);
+      Kokkos::parallel_for(
+          "dcm::model::breakdown_bonds", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_nodes),
+          KOKKOS_LAMBDA(const int i) {
+            for (int d = 0; d < 3; ++d) z(i, d) -= q(i, d);
+          });
+      term("implicit bonds", z);
+    }
+    const auto fresh = [&]() {
+      Kokkos::deep_copy(space_, q, 0.0);
+      return q;
+    };
+    if (last_solve_implicit_ && tension_stiffness_) {
+      apply_tension_stiffness(space_, mesh_, *tension_stiffness_, p, fresh());
+      term("implicit tension", q);
+    }
+    if (last_solve_implicit_ && global_) {
+      apply_global_stiffness(space_, mesh_, *global_, p, fresh());
+      term("global area and volume", q);
+    }
+    if (last_solve_implicit_ && bending_stiffness_) {
+      apply_bending_stiffness(space_, mesh_, *hinges_, *bending_stiffness_, p, fresh());
+      term("implicit bending", q);
+    }
+    if (!named) text += " (each positive: the sum lost its sign to round-off)";
+    return text;
+  }
+
   static std::string unconverged_message(const CgResult& r, const CgSettings& settings) {
     char msg[300];
     if (r.breakdown) {
       std::snprintf(msg, sizeof msg,
-                    "conjugate gradients broke down at iteration %d: p.Gamma p = %.3g W is not positive "
-                    "(the friction operator is not positive definite along a search direction)",
+                    "conjugate gradients broke down at iteration %d: p.A p = %.3g W is not positive "
+                    "(the operator Gamma + dt K is not positive definite along a search direction)",
                     r.iterations, r.curvature);
       return msg;
     }
@@ -827,6 +894,7 @@ class CortexModel {
   bool rounded_geometry_ = true;
   FrictionOperator<Mem> friction_;
   CgWorkspace<Mem> cg_;
+  bool last_solve_implicit_ = false;  // the last solve_velocity() had Δt > 0 (describe_breakdown())
 };
 
 }  // namespace dcm

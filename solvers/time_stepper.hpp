@@ -327,6 +327,7 @@ class TimeStepper {
         if (rep[c].halvings >= settings_.max_halvings ||
             rep[c].unconverged_solves >= settings_.max_solve_halvings)
           throw NumericalError(which(c) + Model::unconverged_message(r[c], cg) +
+                               (r[c].breakdown ? model.describe_breakdown(c) : std::string()) +
                                ", even with the time step halved " + std::to_string(rep[c].halvings) +
                                " times; largest force at node " + std::to_string(model.largest_force_node()));
         h[c] *= 0.5;

@@ -417,6 +417,35 @@ TEST(CortexModel, NonFiniteForceNamesTheNodeAndTerm) {
   }
 }
 
+// A conjugate-gradient breakdown names the operator term that is not positive along its search direction and
+// a node, and lists the others: here a negative dashpot coefficient (no scene allows one; the message is what
+// is tested) makes the friction term indefinite, while the implicit bending and tension stay positive.
+TEST(CortexModel, BreakdownNamesTheTermAndNode) {
+  const HostMesh rest = make_icosphere(2, 3.25e-6);
+  MechanicsParams p = table1();
+  p.implicit_bending = true;
+  p.dashpot = -1e-3;
+  CortexModel<Exec> model(Exec(), {HostCell(rest)}, p);
+  set_positions(model, perturbed(rest, 0.05e-6, 7));
+  model.compute_forces();
+  CgSettings cg;
+  cg.abs_tol = 1e-30;
+  try {
+    model.solve_velocity(cg, 1e-4);
+    FAIL() << "no NumericalError";
+  } catch (const NumericalError& e) {
+    const std::string what = e.what();
+    std::printf("  %s\n", what.c_str());
+    EXPECT_NE(what.find("broke down"), std::string::npos) << what;
+    EXPECT_NE(what.find("friction (drag, dashpots, substrate) -"), std::string::npos) << what;
+    EXPECT_NE(what.find("(the term at fault: lowest at node "), std::string::npos) << what;
+    const auto bending = what.find("implicit bending ");
+    ASSERT_NE(bending, std::string::npos) << what;
+    EXPECT_NE(what[bending + 17], '-') << what;  // positive: named only once, the first term at fault
+    EXPECT_EQ(what.find("term at fault"), what.rfind("term at fault")) << what;
+  }
+}
+
 TEST(CortexModel, WithoutDashpotsTheSolveIsDiagonal) {
   MechanicsParams p = table1();
   p.dashpot = 0;

@@ -296,8 +296,10 @@ BallResult triangulated_ball(const BounceOptions& o, const PlaneContactParams& p
   res.subdivisions = subdivisions;
   res.reach = ball.reach();
   res.traj.g = g;
-  // Contact is possible only while the centre is below reach; the stepping starts a little above that.
-  const double z_enter = ball.reach() + 0.01 * R;
+  // Contact is possible only while the centre is below reach; the stepping starts a little above that, and a
+  // bounce ends when the centre rises past the same height: a margin below the rebound's apex (≈ R + H), so
+  // that a small drop height ends its bounce too (validate(): H ≥ 1e-4 R, reach − R ≤ 2.5e-6 R).
+  const double z_enter = ball.reach() + std::min(0.01 * R, 0.5 * o.drop_height);
   const double tilt = o.tilt_deg * kPi / 180;
   Mat3 Q = rotation({tilt / std::sqrt(5.0), 2 * tilt / std::sqrt(5.0), 0});
   Real3 c{0, 0, R + o.drop_height}, v{0, 0, 0}, w{0, 0, 0};
@@ -495,8 +497,12 @@ void validate(const BounceOptions& o) {
   hertz_contact_time(mat.K, o.radius, mass, std::sqrt(2 * o.gravity * o.drop_height), delta_max);
   // δ_max ∝ H^{2/5}: the largest H with δ_max ≤ 0.1 R.
   const double h_max = o.drop_height * std::pow(0.1 * o.radius / delta_max, 2.5);
-  require(delta_max <= 0.1 * o.radius, "--drop-height-m", o.drop_height,
-          "0 < H <= " + num(h_max) + " m, where the overlap reaches R/10 for these material and ball");
+  // Below 1e-4 R the rebound would not clear the rounded triangles' reach above R by a safe margin (reach − R
+  // is up to 2.5e-6 R: 162 nodes, docs/model/bounce.md) and a bounce could not be told from resting contact.
+  const std::string range = num(1e-4 * o.radius) + " <= H <= " + num(h_max) +
+                            " m: from 1e-4 R to where the overlap reaches R/10 for these material and ball";
+  require(delta_max <= 0.1 * o.radius && o.drop_height >= (1 - 1e-12) * 1e-4 * o.radius, "--drop-height-m",
+          o.drop_height, range);
 }
 
 // ---- the run ----
@@ -672,9 +678,10 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--bounces", o.bounces, "Number of bounces, 1 .. 20")->capture_default_str();
-  app.add_option("--drop-height-m", o.drop_height,
-                 "Initial height of the lowest point above the plane (m), > 0, at most the height whose "
-                 "largest overlap is R/10 (0.138 m for the defaults; a refused value names it)")
+  app.add_option(
+         "--drop-height-m", o.drop_height,
+         "Initial height of the lowest point above the plane (m), at least 1e-4 R, at most the height "
+         "whose largest overlap is R/10 (0.138 m for the defaults; a refused value names it)")
       ->capture_default_str();
   app.add_option("--quadrature-points", o.quadrature_points,
                  "Contact integration: 0 exact polar integration, or the paper's 1, 3, 7, 16-point rules")

@@ -340,6 +340,8 @@ def write_h5(scan, out, rows):
                     frames = sorted(src["frames"]) if "frames" in src else []
                     if frames:
                         src.copy(src["frames"][frames[-1]], mg, "final_frame")
+                        if "mesh/triangles" in src:  # so that the final shape can be drawn from scan.h5 alone
+                            src.copy(src["mesh/triangles"], mg["final_frame"], "triangles")
             except (OSError, KeyError) as e:  # a run killed while writing it (out of memory, a signal)
                 print(f"{PROG}: warning: {src_path} cannot be read ({e}): member {m['id']} has no series in "
                       f"scan.h5", file=sys.stderr)

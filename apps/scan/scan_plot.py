@@ -7,11 +7,13 @@ there, its status in the legend. A
 latin_hypercube scan (every member varies every key) colours all members in each panel by that key's value
 (dark: low, yellow: high) and also draws sensitivity.png: the final r_cc and the free-fit contact angle of
 every member against each swept key (from summary.csv).
+The base member's legend entry gives its value of the panel's key (from its spread.h5's resolved scene).
 usage: scan_plot.py OUT_DIR"""
 import csv, json, math, os, sys
 
 import matplotlib
 
+os.environ.setdefault("HDF5_USE_FILE_LOCKING", "FALSE")
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
@@ -38,6 +40,22 @@ def onset(out, mid):
             return before
         before = t
     return 0.0
+
+
+def base_value(out, mid, key):
+    """The value of scene key `key` in the member's resolved scene (spread.h5's root attribute `scene`), or
+    None where the file or the key cannot be read: the legend's base then says no value."""
+    try:
+        import h5py
+        import tomllib
+        with h5py.File(os.path.join(out, "members", mid, "spread.h5"), "r") as f:
+            text = f.attrs["scene"]
+        value = tomllib.loads(text.decode() if isinstance(text, bytes) else str(text))
+        for part in key.split("."):
+            value = value[part]
+        return value
+    except Exception:  # a missing file, no h5py, a key the scene lacks: the label without the value
+        return None
 
 
 def series(out, mid):
@@ -92,7 +110,9 @@ def main():
         if base:
             t, r = series(out, base["id"])
             if t:
-                ax.loglog(t, r, color="k", lw=1.0, ls="--", label="base" + note(base["id"]))
+                v = base_value(out, base["id"], key)
+                shown = "" if v is None else f" ({v:.3g})" if isinstance(v, float) else f" ({v})"
+                ax.loglog(t, r, color="k", lw=1.0, ls="--", label="base" + shown + note(base["id"]))
                 if unfinished(base["id"]):
                     ax.plot(t[-1], r[-1], "x", color="k", ms=7, mew=1.5)
         all_t = [v for m in members for v in series(out, m["id"])[0]]

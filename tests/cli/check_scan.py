@@ -22,7 +22,15 @@ with h5py.File(os.path.join(out, "scan.h5"), "r") as f:
         assert "series" in g and "final_frame" in g, mid
         assert abs(g.attrs["r_cc_final_m"] - r[mid]) <= 1e-15 * r[mid], mid
         assert g["final_frame"]["x"].shape == (162, 3), mid
+        tri = g["final_frame"]["triangles"][()]
+        assert tri.shape == (320, 3) and tri.min() == 0 and tri.max() == 161, (mid, tri.shape)
 assert os.path.getsize(os.path.join(out, "r_cc_grid.png")) > 10000
+# The plot's legend gives the base member's value of each swept key, read from its resolved scene.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "apps", "scan"))
+import scan_plot  # noqa: E402
+assert scan_plot.base_value(out, "m000", "contact.W_J_per_m2") == 1e-3
+assert scan_plot.base_value(out, "m000", "cortex.k_b_J") == 240e-21
+assert scan_plot.base_value(out, "m000", "no.such_key") is None
 a = open(os.path.join(out, "members", "m002", "series.csv")).read()
 b = open(os.path.join(alone, "series.csv")).read()
 assert a == b, "member m002 differs from the same scene run alone"
