@@ -76,8 +76,15 @@ def series(out, mid):
 
 
 def main():
+    if len(sys.argv) != 2 or sys.argv[1] in ("-h", "--help"):
+        print(__doc__)
+        sys.exit(0 if len(sys.argv) == 2 else 2)
     out = sys.argv[1]
-    scan = json.load(open(os.path.join(out, "scan.json")))
+    try:
+        scan = json.load(open(os.path.join(out, "scan.json")))
+    except (OSError, ValueError) as e:
+        print(f"scan_plot.py: {out}: no readable scan.json ({e}): give a scan's output folder", file=sys.stderr)
+        sys.exit(2)
     keys = scan["sweep_keys"]
     n = len(keys)
     cols = min(3, n)
