@@ -11,6 +11,7 @@
 #include <cstring>
 #include <filesystem>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
 
 namespace dcm {
@@ -479,6 +480,13 @@ void Scene::set(const std::string& key_equals_value) {
 }
 
 void Scene::validate() const {
+  // The name is a folder under out/: a path in it wrote outside out/ (name = "../../escape", session 41).
+  if (name_.find('/') != std::string::npos || name_.find('\\') != std::string::npos || name_ == "." ||
+      name_ == "..")
+    fail(origin_,
+         "name = '" + name_ +
+             "' is not allowed: a folder name under out/ (no '/' or '\\', not '.' or '..'); to write "
+             "elsewhere set output.dir or --out");
   const double h0 = get_real("contact.h0_m");
   const bool sphere = get_string("mesh.shape") == "sphere";
   const double radius = sphere ? get_real("mesh.radius_m") : get_real("mesh.diameter_m") / 2;
@@ -506,6 +514,12 @@ bool Scene::get_bool(const std::string& key) const {
 const std::string& Scene::get_string(const std::string& key) const {
   spec_for(key, ParamType::String, "get_string");
   return values_.at(key);
+}
+
+const std::string& Scene::value_text(const std::string& key) const {
+  const auto it = values_.find(key);
+  if (it == values_.end()) throw std::logic_error("Scene::value_text: no key " + key);
+  return it->second;
 }
 
 bool Scene::was_set(const std::string& key) const {

@@ -59,6 +59,8 @@ class Scene {
   bool get_bool(const std::string& key) const;
   const std::string& get_string(const std::string& key) const;
   bool was_set(const std::string& key) const;  // given in the file or by set(), not a default
+  // Any key's value as its canonical text (TOML syntax for numbers and booleans, bare text for strings).
+  const std::string& value_text(const std::string& key) const;
 
   const std::string& name() const { return name_; }
   const std::string& origin() const { return origin_; }  // file path or "defaults"

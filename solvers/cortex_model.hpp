@@ -785,46 +785,81 @@ class CortexModel {
     return drag;
   }
 
-  // Failure path only: evaluates each term alone to name the one that produced the non-finite value.
-  std::string term_with_non_finite_force(int node) {
+  // Failure path only: each force term evaluated alone into a scratch vector, visit(name, scratch) after each
+  // (in the order of compute_forces()); visit returns true to stop.
+  template <class Visit>
+  void for_each_force_term(Visit&& visit) {
     Vector scratch("dcm::model::scratch", mesh_.n_nodes);
-    auto check = [&](const char* name, auto&& add) -> std::string {
+    const auto term = [&](const char* name, auto&& add) {
       Kokkos::deep_copy(scratch, 0.0);
       add();
-      auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), scratch);
-      for (int d = 0; d < 3; ++d)
-        if (!std::isfinite(h(node, d))) return name;
-      return "";
+      return visit(name, scratch);
     };
-    std::string t;
-    if (bonds_ && (t = check("FENE+POW bonds", [&] {
-                     add_fene_pow_forces(space_, mesh_, *bonds_, bond_params_.table(), scratch,
-                                         overstretched_);
-                   })) != "")
-      return t;
-    if (hinges_ && (t = check("bending", [&] {
-                      add_bending_forces(space_, mesh_, *hinges_, k_b_.table(), scratch);
-                    })) != "")
-      return t;
-    if (area_ && (t = check("area constraints", [&] {
-                    add_area_forces(space_, mesh_, geo_, *area_, k_area_local_.table(),
-                                    k_area_global_.table(), scratch);
-                  })) != "")
-      return t;
-    if (volume_ && (t = check("volume constraint", [&] {
-                      add_volume_forces(space_, mesh_, geo_, *volume_, k_volume_.table(), scratch);
-                    })) != "")
-      return t;
-    if (contact_ && (t = check("plane contact", [&] {
-                       add_plane_contact_forces(space_, mesh_, params_.plane, *contact_, scratch);
-                     })) != "")
-      return t;
-    if (crease_ && (t = check("contact crease",
-                              [&] { add_crease_forces(space_, mesh_, crease_->table(), scratch); })) != "")
-      return t;
-    return "external force or positions";
+    if (bonds_ && term("FENE+POW bonds", [&] {
+          add_fene_pow_forces(space_, mesh_, *bonds_, bond_params_.table(), scratch, overstretched_);
+        }))
+      return;
+    if (hinges_ &&
+        term("bending", [&] { add_bending_forces(space_, mesh_, *hinges_, k_b_.table(), scratch); }))
+      return;
+    if (area_ && term("area constraints", [&] {
+          add_area_forces(space_, mesh_, geo_, *area_, k_area_local_.table(), k_area_global_.table(),
+                          scratch);
+        }))
+      return;
+    if (volume_ && term("volume constraint", [&] {
+          add_volume_forces(space_, mesh_, geo_, *volume_, k_volume_.table(), scratch);
+        }))
+      return;
+    if (contact_ && term("plane contact",
+                         [&] { add_plane_contact_forces(space_, mesh_, params_.plane, *contact_, scratch); }))
+      return;
+    if (crease_ &&
+        term("contact crease", [&] { add_crease_forces(space_, mesh_, crease_->table(), scratch); }))
+      return;
   }
 
+  // Failure path only: the term that produced the non-finite force at `node`.
+  std::string term_with_non_finite_force(int node) {
+    std::string found = "external force or positions";
+    for_each_force_term([&](const char* name, const Vector& f) {
+      auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), f);
+      for (int d = 0; d < 3; ++d)
+        if (!std::isfinite(h(node, d))) {
+          found = name;
+          return true;
+        }
+      return false;
+    });
+    return found;
+  }
+
+ public:
+  // For the messages of an equilibrium that was not reached: "node N (|F| = X N; largest term there: T, Y N)"
+  // for the node with the largest total force (compute_forces() first), external forces included in |F|.
+  std::string describe_largest_force() {
+    const int node = largest_force_node();
+    auto total = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), force_);
+    const double f_node = std::sqrt(total(node, 0) * total(node, 0) + total(node, 1) * total(node, 1) +
+                                    total(node, 2) * total(node, 2));
+    std::string largest = "external force";
+    double f_largest = -1;
+    for_each_force_term([&](const char* name, const Vector& f) {
+      auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), f);
+      const double m = std::sqrt(h(node, 0) * h(node, 0) + h(node, 1) * h(node, 1) + h(node, 2) * h(node, 2));
+      if (m > f_largest) {
+        f_largest = m;
+        largest = name;
+      }
+      return false;
+    });
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "node %d (|F| = %.3g N; largest term there: %s, %.3g N)", node, f_node,
+                  largest.c_str(), f_largest);
+    return buf;
+  }
+
+ private:
   std::string describe_overstretch(int bond) const {
     auto b = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh_.bond);
     auto cell = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh_.bond_cell);

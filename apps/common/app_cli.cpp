@@ -50,6 +50,17 @@ Scene load_scene(const AppOptions& o, const std::vector<std::string>& without_fi
     for (const std::string& s : without_file) scene.set(s);
   for (const std::string& s : o.sets) scene.set(s);
   scene.validate();
+  // A scene file that leaves out a key the app sets without one (stretch and relax: mesh.shape = evans_fung)
+  // runs the scene default instead: say so, since --list-keys shows the default, not what the app runs
+  // without a file (session 41: a scene with only cortex keys stretched a sphere without a word).
+  if (!o.scene_path.empty() && !o.quiet)
+    for (const std::string& s : without_file) {
+      const std::string key = s.substr(0, s.find('='));
+      if (key != "name" && !scene.was_set(key))
+        std::printf("note: %s sets no %s: the scene default %s is used (without a scene file: %s)\n",
+                    o.scene_path.c_str(), key.c_str(), scene.value_text(key).c_str(),
+                    s.substr(s.find('=') + 1).c_str());
+    }
   return scene;
 }
 
@@ -120,6 +131,13 @@ int run_app(CLI::App& app, int argc, char** argv, const std::function<void()>& b
   }
   try {
     body();
+    // What an app printed on stdout is part of its output (contact-probe's CSV, contact-law's table): a write
+    // that failed (a full disk, a closed file) must not end in exit 0 with the data silently lost.
+    std::cout.flush();
+    if (std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout)
+      throw IoError(
+          "standard output: the write failed (a full disk or a closed file?); what was printed is "
+          "incomplete");
     return 0;
   } catch (const SceneError& e) {
     std::cerr << name << ": error: " << e.what() << '\n';

@@ -42,7 +42,7 @@ bool validate(const Options& o) {
   // solved to full precision there; far outside (E = 1e-300 Pa, h0 = 1e-200 m, W = 1e300 J/m²) its terms
   // overflow or underflow and it printed inf or empty loads (session 40).
   bool ok = check(o.E >= 1 && o.E <= 1e9, "--E", o.E, "1 <= E <= 1e9 Pa") &&
-            check(o.nu >= 0 && o.nu < 0.5, "--nu", o.nu, "0 <= nu < 0.5") &&
+            check(o.nu >= 0 && o.nu <= 0.5, "--nu", o.nu, "0 <= nu <= 0.5") &&
             check(o.W >= 0 && o.W <= 1, "--W", o.W, "0 <= W <= 1 J/m^2") &&
             check(o.h0 >= 1e-12 && o.h0 <= 1e-6, "--h0", o.h0, "1e-12 <= h0 <= 1e-6 m") &&
             check(o.R >= 1e-9 && o.R <= 1e-3, "--R", o.R, "1e-9 <= R <= 1e-3 m");
@@ -89,14 +89,15 @@ int main(int argc, char** argv) {
       "radius, lambda Maugis' parameter, Abar = a/(pi W R^2/K)^(1/3), Pbar = P/(pi W R), P net load "
       "(repulsive > 0). In the gap branch a = 0 and m is empty (undefined; c is 0 beyond h0). With W = 0 "
       "(Hertz) "
-      "Abar and Pbar are undefined: empty fields.\n"
+      "Abar and Pbar are undefined: empty fields (also where W is so small, below ~1e-300, that their units "
+      "underflow).\n"
       "Model and checks: docs/model/contact.md",
       "contact-law");
   app.footer(
       "Example:\n  contact-law --W 1e-3 --h0 20e-9 --R 3.25e-6 --a 1e-7 --a 2e-7 --delta=-5e-9\n"
       "Exit codes: 0 success, 2 bad input (one line on stderr).");
   app.add_option("--E", o.E, "Young's modulus of the cell cortex (Pa), 1 <= E <= 1e9")->capture_default_str();
-  app.add_option("--nu", o.nu, "Poisson ratio, 0 <= nu < 0.5")->capture_default_str();
+  app.add_option("--nu", o.nu, "Poisson ratio, 0 <= nu <= 0.5 (as cortex.nu)")->capture_default_str();
   app.add_option("--W", o.W, "Work of adhesion (J/m^2), 0 <= W <= 1 (0: Hertz)")->capture_default_str();
   app.add_option("--h0", o.h0, "Range of the Dugdale stress (m), 1e-12 <= h0 <= 1e-6; sigma0 = W/h0")
       ->capture_default_str();
@@ -124,6 +125,10 @@ int main(int argc, char** argv) {
       print_row(dcm::md_state_from_radius(o.a[ia++], o.R, mat), o, mat);
     if (opt->get_name() == "--delta" && id < o.delta.size())
       print_row(dcm::md_state_from_overlap(o.delta[id++], o.R, mat), o, mat);
+  }
+  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {  // the table is the output: a lost write is an error
+    std::cerr << "contact-law: error: standard output: the write failed (a full disk or a closed file?)\n";
+    return 2;
   }
   return 0;
 }

@@ -38,9 +38,20 @@ void probe(const std::string& path, const std::vector<std::string>& sets, bool a
       throw dcm::SceneError("--set " + s +
                             ": only contact.*, geometry.*, cortex.E_Pa and cortex.nu may change "
                             "(the shape is the checkpoint's)");
+    // Keys the triangles' loads and regimes do not depend on would be accepted and change nothing.
+    for (const char* ignored : {"contact.crease_radius_m", "contact.friction_weights",
+                                "contact.friction_zone", "contact.start_gap_m"})
+      if (key == ignored)
+        throw dcm::SceneError("--set " + s + ": " + key +
+                              " does not change the contact loads this probe reports (the crease, the "
+                              "substrate friction and the start gap act elsewhere)");
     scene.set(s);
   }
   scene.validate();
+  if (!scene.get_bool("contact.plane"))
+    throw dcm::SceneError(
+        "contact.plane = false: there is no plane to probe (the checkpoint's scene has none, "
+        "or --set turned it off)");
   dcm::CortexModel<Exec> model(Exec(), {dcm::HostCell(dcm::cell_mesh_from_scene(scene))},
                                dcm::mechanics_from_scene(scene));
   model.restore_cell_state(c, 0);

@@ -90,8 +90,13 @@ void run(const Options& o) {
     scene.set(set);
   }
   scene.validate();
+  if (!(scene.get_real("cortex.k_v") > 0))
+    throw dcm::SceneError("cortex.k_v = " + dcm::detail::format_real(scene.get_real("cortex.k_v")) +
+                          " is not allowed: deflate needs the volume constraint, which sets the volume it "
+                          "deflates to (allowed > 0)");
   // The mechanics' own checks before any file is touched (a refused run leaves an earlier one's files alone).
   const dcm::MechanicsParams params = dcm::mechanics_from_scene(scene);
+  dcm::check_output_dir(o.out);  // before the equilibrium's seconds, as the other apps do
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
   if (ec || !std::filesystem::is_directory(o.out))
@@ -114,15 +119,21 @@ void run(const Options& o) {
   if (!o.quiet) ns.progress_s = 10;
   const double edge = 4.0 * scene.get_real("mesh.radius_m") / std::sqrt(static_cast<double>(o.nodes));
   const dcm::NewtonResult r = dcm::newton_equilibrium(model, ns, edge);
-  if (!r.converged)
+  model.compute_forces();  // geometry of the final shape (and, when it failed, the forces the message names)
+  if (!r.converged) {
+    std::error_code rm;  // nothing was written yet: no empty folder left behind
+    if (std::filesystem::is_empty(o.out, rm)) std::filesystem::remove(o.out, rm);
     throw dcm::NumericalError("no equilibrium after " + std::to_string(r.newton_steps) +
-                              " Newton steps (largest force " + std::to_string(r.max_force) + " N)");
-  model.compute_forces();  // geometry of the final shape
+                              " Newton steps; the largest force is at " + model.describe_largest_force());
+  }
   const auto x = dcm::to_host_vector(model.positions());
   const double area = dcm::to_host_vector(model.geometry().cell_area)[0];
   const double volume = dcm::to_host_vector(model.geometry().cell_volume)[0];
   const double pi = std::acos(-1.0);
   const double reduced = 6 * std::sqrt(pi) * volume / std::pow(area, 1.5);
+  // The volume reached against the target: a soft volume term (small cortex.k_v) stops short of it.
+  const double sphere_volume = 4.0 / 3.0 * pi * std::pow(scene.get_real("mesh.radius_m"), 3);
+  const double fraction = volume / sphere_volume;
   // Symmetry axis: z (the squash direction); centre: the node centroid.
   const int n = o.nodes;
   double c[3] = {0, 0, 0};
@@ -178,6 +189,7 @@ void run(const Options& o) {
   dcm::JsonObject json;
   json.add("nodes", n)
       .add("volume_fraction_target", o.volume_fraction)
+      .add("volume_fraction_reached", fraction)
       .add("squash", o.squash)
       .add("sets", o.sets)
       .add("newton_steps", r.newton_steps)
@@ -197,6 +209,12 @@ void run(const Options& o) {
       .add("evans_fung_rho_of_thickness_max_m", 2.738e-6)
       .add("evans_fung_reduced_volume", 0.644);
   json.write(o.out + "/summary.json");
+  if (std::fabs(fraction / o.volume_fraction - 1) > 0.01)
+    std::fprintf(
+        stderr,
+        "deflate: warning: the volume reached V/V_sphere = %.3f, not the target %.3f: the volume term "
+        "(cortex.k_v = %.3g) is too soft against the area terms to deflate the cell that far\n",
+        fraction, o.volume_fraction, scene.get_real("cortex.k_v"));
   if (!o.quiet)
     std::printf(
         "deflate: %d nodes, V/V_sphere -> %.3f from a start squashed to %.2f: %d Newton steps; reduced "
@@ -204,9 +222,8 @@ void run(const Options& o) {
         "%.3f, area %.4f of the sphere's, diameter %.2f um, thickness %.2f um at the centre, %.2f um at rho "
         "= "
         "%.2f um (%s); Evans-Fung: 7.82, 0.81, 2.57 at 2.74 um -> %s\n",
-        n, o.volume_fraction, o.squash, r.newton_steps, reduced, area / sphere_area, 2e6 * rho_max,
-        1e6 * t_centre, 1e6 * t_max, 1e6 * rho_at_max, t_centre < t_max ? "biconcave" : "not biconcave",
-        o.out.c_str());
+        n, fraction, o.squash, r.newton_steps, reduced, area / sphere_area, 2e6 * rho_max, 1e6 * t_centre,
+        1e6 * t_max, 1e6 * rho_at_max, t_centre < t_max ? "biconcave" : "not biconcave", o.out.c_str());
 }
 
 }  // namespace

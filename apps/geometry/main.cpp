@@ -106,9 +106,14 @@ void run(const AppOptions& options) {
       std::printf("  volume       %.6g um^3   (4/3 pi R^3 = %.6g, %+.3f%%)\n", volume * 1e18,
                   4 * kPi * rad * rad * rad / 3 * 1e18, 100 * (volume / (4 * kPi * rad * rad * rad / 3) - 1));
     } else {
-      std::printf("   (Evans-Fung at D = 7.82 um: 134.09, %+.3f%%)\n", 100 * (area * 1e12 / 134.09 - 1));
-      std::printf("  volume       %.6g um^3   (Evans-Fung at D = 7.82 um: 94.10, %+.3f%%)\n", volume * 1e18,
-                  100 * (volume * 1e18 / 94.10 - 1));
+      // The continuum Evans-Fung cell's area and volume at D = 7.82 um, scaled to this cell's diameter (D^2,
+      // D^3; until session 41 every diameter was compared with the 7.82-um values).
+      const double d_um = scene.get_real("mesh.diameter_m") * 1e6, k = d_um / 7.82;
+      const double a_ref = 134.09 * k * k, v_ref = 94.10 * k * k * k;
+      std::printf("   (Evans-Fung at D = %.4g um: %.6g, %+.3f%%)\n", d_um, a_ref,
+                  100 * (area * 1e12 / a_ref - 1));
+      std::printf("  volume       %.6g um^3   (Evans-Fung at D = %.4g um: %.6g, %+.3f%%)\n", volume * 1e18,
+                  d_um, v_ref, 100 * (volume * 1e18 / v_ref - 1));
     }
     std::printf("  reduced vol. %.4f  (6 sqrt(pi) V / A^1.5; 1 for a sphere)\n", reduced_volume);
     std::printf("  node H       min %.4g  mean %.4g  max %.4g 1/um\n", h.min * 1e-6, h.mean() * 1e-6,

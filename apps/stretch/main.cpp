@@ -42,9 +42,19 @@ struct StretchOptions {
 void run(const AppOptions& options, const StretchOptions& so) {
   // Without a scene file: the paper's experiment, a 2562-node Evans-Fung cell with Table 1 constants.
   const Scene scene = load_scene(options, {"name=stretch", "mesh.shape=evans_fung"});
-  for (double f : so.forces_pN)
+  if (so.forces_pN.empty())
+    throw SceneError(
+        "--forces-pN is empty: give at least one force, 0 .. 10000 pN (e.g. --forces-pN 0,50,100)");
+  for (std::size_t i = 0; i < so.forces_pN.size(); ++i) {
+    const double f = so.forces_pN[i];
     if (!(f >= 0 && f <= 1e4))
       throw SceneError("--forces-pN = " + detail::format_real(f) + " is out of range: allowed 0 .. 10000");
+    for (std::size_t j = 0; j < i;
+         ++j)  // each frame is timed by its force: two frames at one time in ParaView
+      if (so.forces_pN[j] == f)
+        throw SceneError("--forces-pN = " + detail::format_real(f) +
+                         " is given twice: allowed each force once (stretch.xmf times its frames by F)");
+  }
   check_pulled_fraction(so.pulled_fraction);
   check_no_plane("stretch", scene);
   // Every check before the output folder is touched (--check included): a refused run leaves an earlier
@@ -110,11 +120,9 @@ void run(const AppOptions& options, const StretchOptions& so) {
                   r.converged ? "" : ", NOT CONVERGED");
     std::fflush(stdout);
     if (!r.converged) {
-      char msg[160];
-      std::snprintf(msg, sizeof msg,
-                    "did not reach equilibrium in %d Newton steps (largest node force %.3g N)",
-                    r.newton_steps, r.max_force);
-      fail(msg);
+      model.compute_forces();  // the forces at the last iterate, for the message
+      fail("did not reach equilibrium in " + std::to_string(r.newton_steps) +
+           " Newton steps; the largest force is at " + model.describe_largest_force());
     }
     forces.push_back(f);
     da.push_back(d_axial);
