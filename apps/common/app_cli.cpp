@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -71,6 +72,18 @@ bool stop_after_check(const std::string& app, const AppOptions& o, const Scene& 
     std::printf("%s: scene %s: ok (checked, nothing written)\n", app.c_str(), scene.name().c_str());
   return true;
 }
+
+namespace {
+volatile std::sig_atomic_t g_stop_requested = 0;
+extern "C" void on_stop_signal(int) { g_stop_requested = 1; }
+}  // namespace
+
+void install_stop_handler() {
+  std::signal(SIGINT, on_stop_signal);
+  std::signal(SIGTERM, on_stop_signal);
+}
+
+bool stop_requested() { return g_stop_requested != 0; }
 
 std::string output_dir_of(const AppOptions& o, const Scene& scene) {
   std::string dir = o.out_dir;

@@ -22,6 +22,11 @@ struct AppInterrupted : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// SIGINT/SIGTERM set a flag instead of killing the app (stretch, relax; spread has its own): the app checks
+// stop_requested() between its steps, closes its files with what was done and throws AppInterrupted.
+void install_stop_handler();
+bool stop_requested();
+
 struct AppOptions {
   std::string scene_path;         // empty: the built-in defaults
   std::vector<std::string> sets;  // key=value overrides, applied in order after the file

@@ -96,13 +96,9 @@ void run(const Options& o) {
                           "deflates to (allowed > 0)");
   // The mechanics' own checks before any file is touched (a refused run leaves an earlier one's files alone).
   const dcm::MechanicsParams params = dcm::mechanics_from_scene(scene);
-  dcm::check_output_dir(o.out);  // before the equilibrium's seconds, as the other apps do
-  std::error_code ec;
-  std::filesystem::create_directories(o.out, ec);
-  if (ec || !std::filesystem::is_directory(o.out))
-    throw dcm::IoError("--out " + o.out + ": cannot create the folder (" + ec.message() + ")");
-  dcm::remove_earlier_outputs(o.out,
-                              {"summary.json", "profile.csv", "shape.csv", "deflate.h5", "deflate.xmf"});
+  // The folder is checked before the equilibrium's seconds, as the other apps do, and made after it: a run
+  // stopped by Ctrl-C or failing leaves no empty folder and an earlier run's files alone.
+  dcm::check_output_dir(o.out);
   const dcm::HostMesh sphere = dcm::cell_mesh_from_scene(scene);
   dcm::CortexModel<Exec> model(Exec(), {dcm::HostCell(sphere)}, params);
   model.set_flat_bending_rest();
@@ -120,12 +116,15 @@ void run(const Options& o) {
   const double edge = 4.0 * scene.get_real("mesh.radius_m") / std::sqrt(static_cast<double>(o.nodes));
   const dcm::NewtonResult r = dcm::newton_equilibrium(model, ns, edge);
   model.compute_forces();  // geometry of the final shape (and, when it failed, the forces the message names)
-  if (!r.converged) {
-    std::error_code rm;  // nothing was written yet: no empty folder left behind
-    if (std::filesystem::is_empty(o.out, rm)) std::filesystem::remove(o.out, rm);
+  if (!r.converged)
     throw dcm::NumericalError("no equilibrium after " + std::to_string(r.newton_steps) +
                               " Newton steps; the largest force is at " + model.describe_largest_force());
-  }
+  std::error_code ec;
+  std::filesystem::create_directories(o.out, ec);
+  if (ec || !std::filesystem::is_directory(o.out))
+    throw dcm::IoError("--out " + o.out + ": cannot create the folder (" + ec.message() + ")");
+  dcm::remove_earlier_outputs(o.out,
+                              {"summary.json", "profile.csv", "shape.csv", "deflate.h5", "deflate.xmf"});
   const auto x = dcm::to_host_vector(model.positions());
   const double area = dcm::to_host_vector(model.geometry().cell_area)[0];
   const double volume = dcm::to_host_vector(model.geometry().cell_volume)[0];

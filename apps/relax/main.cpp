@@ -54,6 +54,12 @@ double fit_relaxation_time(const std::vector<double>& t, const std::vector<doubl
   return -stt / sty;
 }
 
+std::string short_seconds(double t) {  // for messages: 0.0563, not 0.056274000000000005
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", t);
+  return b;
+}
+
 void run(const AppOptions& options, const RelaxOptions& ro) {
   // Without a scene file: the paper's experiment, a 2562-node Evans-Fung cell with Table 1 constants.
   const Scene scene = load_scene(options, {"name=relax", "mesh.shape=evans_fung"});
@@ -101,7 +107,14 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
   // 1e-4 of the force per pulled node, but not below 1e-17 N (round-off of the cortex forces: a hold force of
   // 1e-6 pN asked for 1e-22 N and failed; stretch uses the same floor).
   ns.force_tol = std::max(1e-4 * ro.hold_force_pN * 1e-12 / left.size(), 1e-17);
+  install_stop_handler();  // Ctrl-C: after the hold, nothing kept; during the release, the step under way
+                           // gets its row and frame, then the files are closed
   const NewtonResult held = newton_equilibrium(model, ns, mean_edge_length(mesh, build_topology(mesh)));
+  if (stop_requested()) {
+    std::error_code ec;  // nothing was written yet: no empty folder left behind
+    if (std::filesystem::is_empty(out, ec)) std::filesystem::remove(out, ec);
+    throw AppInterrupted("interrupted while holding the stretched cell, before the release; nothing written");
+  }
   if (!held.converged) {
     std::error_code ec;  // nothing was written yet: no empty folder left behind
     if (std::filesystem::is_empty(out, ec)) std::filesystem::remove(out, ec);
@@ -135,6 +148,8 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
   const double y0 = (da0 / dt0 - lambda_inf) / (da0 / dt0 + lambda_inf);
   long long cg_total = 0;
   int cg_max = 0;
+  long long steps_done = steps;
+  bool interrupted = false;
   for (long long step = 0; step <= steps; ++step) {
     const double t = step * dt;
     CgResult r;
@@ -150,7 +165,8 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
     }
     cg_total += r.iterations;
     cg_max = std::max(cg_max, r.iterations);
-    const bool last = step == steps;  // the end state always gets a row and a frame
+    interrupted = stop_requested() && step < steps;
+    const bool last = step == steps || interrupted;  // the end state always gets a row and a frame
     if (step % ro.sample_every == 0 || last) {
       const auto x = to_host_vector(model.positions());
       const auto [da, dtr] = axial_transverse_diameters(x);
@@ -169,6 +185,10 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
                       dtr * 1e6, r.iterations, 100.0 * step / steps);
         std::fflush(stdout);  // progress must show when the output goes to a file
       }
+    }
+    if (interrupted) {
+      steps_done = step;
+      break;
     }
     if (!last) model.advance(dt);
   }
@@ -193,15 +213,19 @@ void run(const AppOptions& options, const RelaxOptions& ro) {
       .add("relaxation_time_s", tc)
       .add("y_end_relative", y_end_rel)
       .add("dt_s", dt)
-      .add("t_end_s", steps * dt)
-      .add("steps", steps)
-      .add("mean_cg_iterations", static_cast<double>(cg_total) / (steps + 1))
+      .add("t_end_s", steps_done * dt)
+      .add("steps", steps_done)
+      .add("interrupted", interrupted)
+      .add("mean_cg_iterations", static_cast<double>(cg_total) / (steps_done + 1))
       .add("max_cg_iterations", cg_max)
       .add("wall_s", wall);
   summary.write(out + "/summary.json");
+  if (interrupted)
+    throw AppInterrupted("interrupted at t = " + short_seconds(steps_done * dt) + " s; " + out +
+                         "/series.csv, summary.json" + (h5 ? " and relax.h5" : "") + " hold the steps done");
   if (!options.quiet && fitted)
     std::printf("  relaxation time t_c = %.4g s; mean CG iterations %.1f (max %d); %.1f s\n", tc,
-                static_cast<double>(cg_total) / (steps + 1), cg_max, wall);
+                static_cast<double>(cg_total) / (steps_done + 1), cg_max, wall);
   if (!fitted && !(y0 > 1e-3))  // (a hold force so small that the held cell is its rest shape; session 40)
     std::fprintf(stderr,
                  "relax: warning: no relaxation time could be fitted (relaxation_time_s is null): the held "
@@ -241,7 +265,8 @@ int main(int argc, char** argv) {
   dcm::RelaxOptions ro;
   dcm::add_common_options(app, options,
                           {"", "--set mesh.nodes=642 --duration-s 0.6 --out out/relax642",
-                           "scenes/relax.toml --hold-force-pN 20"});
+                           "scenes/relax.toml --hold-force-pN 20"},
+                          true);
   app.add_option(
       "--hold-force-pN", ro.hold_force_pN,
       "Force holding the cell before the release (pN), > 0 .. 10000 (default 13: D_A ≈ 8.9 um, the "

@@ -89,7 +89,13 @@ void run(const AppOptions& options, const StretchOptions& so) {
   csv << "F_N,DA_m,DT_m,newton_steps,max_residual_force_N\n";
   std::vector<double> forces, da, dt;
   auto ext = Kokkos::create_mirror_view(model.external_force());
+  install_stop_handler();  // Ctrl-C: stop after the current force, keep the forces done
+  bool interrupted = false;
   for (double f_pN : so.forces_pN) {
+    if (stop_requested()) {
+      interrupted = true;
+      break;
+    }
     const double f = f_pN * 1e-12;
     Kokkos::deep_copy(ext, 0.0);
     for (int i : left) ext(i, 0) = -f / left.size();
@@ -148,8 +154,13 @@ void run(const AppOptions& options, const StretchOptions& so) {
       .add("forces_N", forces)
       .add("DA_m", da)
       .add("DT_m", dt)
-      .add("wall_s", wall);
+      .add("wall_s", wall)
+      .add("interrupted", interrupted);
   summary.write(out + "/summary.json");
+  if (interrupted)
+    throw AppInterrupted("interrupted after " + std::to_string(forces.size()) + " of " +
+                         std::to_string(so.forces_pN.size()) + " forces; " + out +
+                         "/series.csv, summary.json" + (h5 ? " and stretch.h5" : "") + " hold them");
   if (!options.quiet)
     std::printf("  wrote %s/series.csv, summary.json%s (%.1f s)\n", out.c_str(), h5 ? ", stretch.h5" : "",
                 wall);
@@ -174,7 +185,8 @@ int main(int argc, char** argv) {
   dcm::StretchOptions so;
   dcm::add_common_options(app, options,
                           {"", "--set mesh.nodes=642 --forces-pN 0,50,100,200 --out out/stretch642",
-                           "scenes/stretch.toml --pulled-fraction 0.05"});
+                           "scenes/stretch.toml --pulled-fraction 0.05"},
+                          true);
   app.add_flag("--no-plot", so.no_plot, "Do not draw stretch.png");
   app.add_option(
          "--pulled-fraction", so.pulled_fraction,
