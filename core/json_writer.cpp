@@ -1,9 +1,13 @@
 #include "core/json_writer.hpp"
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <stdexcept>
+
+#include "core/errors.hpp"
 
 namespace dcm {
 
@@ -93,13 +97,23 @@ std::string JsonObject::str() const {
 }
 
 void JsonObject::write(const std::string& path) const {
+  // An I/O failure (a full disk, a folder where the file goes) is the user's to fix: IoError, exit 2, and the
+  // temporary file removed (session 41: geometry left geometry.json.tmp and called it an internal error).
   const std::string tmp = path + ".tmp";
   {
     std::ofstream f(tmp);
     f << str();
-    if (!f) throw std::runtime_error(path + ": cannot write file");
+    f.close();
+    if (!f) {
+      std::remove(tmp.c_str());
+      throw IoError(path + ": cannot write the file (" + tmp + " could not be written)");
+    }
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error(path + ": cannot write file");
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    std::remove(tmp.c_str());
+    throw IoError(path + ": cannot write the file (" + std::strerror(err) + ")");
+  }
 }
 
 }  // namespace dcm

@@ -28,7 +28,8 @@ void add_common_options(CLI::App& app, AppOptions& o, const std::vector<std::str
   app.add_option("--set", o.sets,
                  "Override a scene key, e.g. --set mesh.nodes=642 --set mesh.shape=evans_fung (repeatable; "
                  "--list-keys shows every key)")
-      ->type_name("KEY=VALUE");
+      ->type_name("KEY=VALUE")
+      ->allow_extra_args(false);  // one value per --set: a scene file after it stays the scene file
   app.add_option("--out", o.out_dir,
                  "Output folder (default: the scene's output.dir, else out/<scene name>)");
   app.add_option("--threads", o.threads, "Host threads (default: OMP_NUM_THREADS, else all cores)")

@@ -124,7 +124,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> sets;
   bool all = false;
   app.add_option("CHECKPOINT", path, "checkpoint.h5 written by spread")->required();
-  app.add_option("--set", sets, "KEY=VALUE: change a contact.*, geometry.*, cortex.E_Pa or cortex.nu key");
+  app.add_option("--set", sets, "KEY=VALUE: change a contact.*, geometry.*, cortex.E_Pa or cortex.nu key")
+      ->allow_extra_args(false);
   app.add_flag("--all", all, "every triangle, also those without contact");
   int threads = 0;
   app.add_option("--threads", threads, "Host threads (default: OMP_NUM_THREADS, else all cores)")

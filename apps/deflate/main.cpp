@@ -252,7 +252,8 @@ int main(int argc, char** argv) {
   app.add_option("--set", o.sets,
                  "KEY=VALUE: a cortex.* constant of the deflation (e.g. softer springs: --set "
                  "cortex.k_s_N_per_m=3.2e-8); default Table 1")
-      ->type_name("KEY=VALUE");
+      ->type_name("KEY=VALUE")
+      ->allow_extra_args(false);
   return dcm::run_app(app, argc, argv, [&] {
     dcm::KokkosSession kokkos(o.threads);
     run(o);

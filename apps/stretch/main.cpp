@@ -195,6 +195,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.001, 0.25));
   app.add_option("--forces-pN", so.forces_pN,
                  "Stretching forces in pN (default: the Mills 2004 forces and 200)")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->allow_extra_args(false);  // "--forces-pN 0,50 SCENE": SCENE is the scene file, not a force
   return dcm::run_app(app, argc, argv, [&] { dcm::run(options, so); });
 }
