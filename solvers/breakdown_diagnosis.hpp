@@ -25,23 +25,22 @@ int breakdown_node(const ExecutionSpace& space, const NodeCell& node_cell, int c
       Kokkos::Min<int>(first_bad));
   not_finite = first_bad < n;
   if (not_finite) return first_bad;
-  double lowest = INFINITY;
+  // The lowest value and its node in one reduction (a second kernel that matched the minimum again could
+  // round differently); -1 if the cell has no node.
+  using MinLoc = Kokkos::MinLoc<double, int>;
+  typename MinLoc::value_type lowest;
   Kokkos::parallel_reduce(
-      "dcm::breakdown::lowest_value", Kokkos::RangePolicy<ExecutionSpace>(space, 0, n),
-      KOKKOS_LAMBDA(const int i, double& low) {
+      "dcm::breakdown::lowest", Kokkos::RangePolicy<ExecutionSpace>(space, 0, n),
+      KOKKOS_LAMBDA(const int i, typename MinLoc::value_type& low) {
+        if (node_cell(i) != cell) return;
         const double v = p(i, 0) * ap(i, 0) + p(i, 1) * ap(i, 1) + p(i, 2) * ap(i, 2);
-        if (node_cell(i) == cell && v < low) low = v;
+        if (v < low.val || (v == low.val && i < low.loc)) {
+          low.val = v;
+          low.loc = i;
+        }
       },
-      Kokkos::Min<double>(lowest));
-  int node = n;
-  Kokkos::parallel_reduce(
-      "dcm::breakdown::lowest_node", Kokkos::RangePolicy<ExecutionSpace>(space, 0, n),
-      KOKKOS_LAMBDA(const int i, int& m) {
-        const double v = p(i, 0) * ap(i, 0) + p(i, 1) * ap(i, 1) + p(i, 2) * ap(i, 2);
-        if (node_cell(i) == cell && v <= lowest && i < m) m = i;
-      },
-      Kokkos::Min<int>(node));
-  return node < n ? node : -1;
+      MinLoc(lowest));
+  return lowest.loc >= 0 && lowest.loc < n ? lowest.loc : -1;
 }
 
 }  // namespace dcm

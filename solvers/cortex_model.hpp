@@ -842,17 +842,24 @@ class CortexModel {
     auto total = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), force_);
     const double f_node = std::sqrt(total(node, 0) * total(node, 0) + total(node, 1) * total(node, 1) +
                                     total(node, 2) * total(node, 2));
-    std::string largest = "external force";
-    double f_largest = -1;
+    std::string largest;
+    double f_largest = -1, rest[3] = {total(node, 0), total(node, 1), total(node, 2)};
     for_each_force_term([&](const char* name, const Vector& f) {
       auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), f);
       const double m = std::sqrt(h(node, 0) * h(node, 0) + h(node, 1) * h(node, 1) + h(node, 2) * h(node, 2));
+      for (int d = 0; d < 3; ++d) rest[d] -= h(node, d);
       if (m > f_largest) {
         f_largest = m;
         largest = name;
       }
       return false;
     });
+    // What the terms leave of the total: the external forces and gravity (stretch's pull, a spread's weight).
+    const double m_rest = std::sqrt(rest[0] * rest[0] + rest[1] * rest[1] + rest[2] * rest[2]);
+    if (m_rest > f_largest) {
+      f_largest = m_rest;
+      largest = "external force and gravity";
+    }
     char buf[200];
     std::snprintf(buf, sizeof buf, "node %d (|F| = %.3g N; largest term there: %s, %.3g N)", node, f_node,
                   largest.c_str(), f_largest);

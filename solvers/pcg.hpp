@@ -166,12 +166,15 @@ void update_iterate(const ExecutionSpace& space, const SumPlan<MemorySpace>& pla
 }
 
 // p = z + β p with each node's segment's β.
-template <class ExecutionSpace, class Vector, class Scalars, class Segments>
+// Segments that stopped (active = 0) keep their p: a segment that broke down keeps the direction along which
+// p·Ap was not positive, for the message that names the term (CortexModel::describe_breakdown).
+template <class ExecutionSpace, class Segments, class Scalars, class Vector, class Active>
 void next_direction(const ExecutionSpace& space, const Segments& seg, const Scalars& beta, const Vector& z,
-                    const Vector& p) {
+                    const Vector& p, const Active& active) {
   Kokkos::parallel_for(
       "dcm::cg::direction", Kokkos::RangePolicy<ExecutionSpace>(space, 0, static_cast<int>(p.extent(0))),
       KOKKOS_LAMBDA(const int i) {
+        if (!active(seg(i))) return;
         const double bt = beta(seg(i));
         for (int d = 0; d < 3; ++d) p(i, d) = z(i, d) + bt * p(i, d);
       });
@@ -265,7 +268,7 @@ CgResult pcg_solve(const ExecutionSpace& space, Apply&& apply, Precondition&& pr
       if (active[s]) rz[s] = rz_new[s];
     }
     Kokkos::deep_copy(space, beta, w.beta_host);
-    cg_detail::next_direction(space, seg, beta, z, p);
+    cg_detail::next_direction(space, seg, beta, z, p, w.active);
   }
   return cg_detail::combine(res);
 }

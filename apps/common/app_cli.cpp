@@ -46,16 +46,16 @@ void add_common_options(CLI::App& app, AppOptions& o, const std::vector<std::str
       "Print every scene key with its type, default, unit and allowed range, then exit");
 }
 
-Scene load_scene(const AppOptions& o, const std::vector<std::string>& without_file) {
+Scene load_scene(const AppOptions& o, const std::vector<std::string>& without_file, bool note_defaults) {
   Scene scene = o.scene_path.empty() ? Scene::defaults() : Scene::from_file(o.scene_path);
   if (o.scene_path.empty())
     for (const std::string& s : without_file) scene.set(s);
   for (const std::string& s : o.sets) scene.set(s);
   scene.validate();
-  // A scene file that leaves out a key the app sets without one (stretch and relax: mesh.shape = evans_fung)
-  // runs the scene default instead: say so, since --list-keys shows the default, not what the app runs
-  // without a file (session 41: a scene with only cortex keys stretched a sphere without a word).
-  if (!o.scene_path.empty() && !o.quiet)
+  // note_defaults (stretch, relax): a scene file that leaves out a key the app sets without one (mesh.shape =
+  // evans_fung) runs the scene default instead: say so, since --list-keys shows the default, not what the app
+  // runs without a file (session 41: a scene with only cortex keys stretched a sphere without a word).
+  if (note_defaults && !o.scene_path.empty() && !o.quiet)
     for (const std::string& s : without_file) {
       const std::string key = s.substr(0, s.find('='));
       if (key != "name" && !scene.was_set(key))
@@ -76,7 +76,12 @@ bool stop_after_check(const std::string& app, const AppOptions& o, const Scene& 
 
 namespace {
 volatile std::sig_atomic_t g_stop_requested = 0;
-extern "C" void on_stop_signal(int) { g_stop_requested = 1; }
+// The first signal asks for a clean stop; the handler then steps aside, so that a second Ctrl-C ends the app
+// at once (a Newton solve of a fine mesh can take minutes before the next check).
+extern "C" void on_stop_signal(int sig) {
+  g_stop_requested = 1;
+  std::signal(sig, SIG_DFL);
+}
 }  // namespace
 
 void install_stop_handler() {
@@ -145,13 +150,6 @@ int run_app(CLI::App& app, int argc, char** argv, const std::function<void()>& b
   }
   try {
     body();
-    // What an app printed on stdout is part of its output (contact-probe's CSV, contact-law's table): a write
-    // that failed (a full disk, a closed file) must not end in exit 0 with the data silently lost.
-    std::cout.flush();
-    if (std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout)
-      throw IoError(
-          "standard output: the write failed (a full disk or a closed file?); what was printed is "
-          "incomplete");
     return 0;
   } catch (const SceneError& e) {
     std::cerr << name << ": error: " << e.what() << '\n';

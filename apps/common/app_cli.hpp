@@ -48,8 +48,10 @@ void add_common_options(CLI::App& app, AppOptions& options, const std::vector<st
 bool stop_after_check(const std::string& app, const AppOptions& options, const Scene& scene);
 
 // The scene from the file (or the built-in defaults changed by `without_file`, e.g. an app's own
-// experiment), with every --set applied, validated. Throws SceneError.
-Scene load_scene(const AppOptions& options, const std::vector<std::string>& without_file = {});
+// experiment), with every --set applied, validated. Throws SceneError. note_defaults: print a note (stdout)
+// for each key of `without_file` that a given scene file leaves at the scene default.
+Scene load_scene(const AppOptions& options, const std::vector<std::string>& without_file = {},
+                 bool note_defaults = false);
 
 // The output folder: --out, else output.dir, else out/<scene name>.
 std::string output_dir_of(const AppOptions& options, const Scene& scene);

@@ -40,7 +40,8 @@ void probe(const std::string& path, const std::vector<std::string>& sets, bool a
                             "(the shape is the checkpoint's)");
     // Keys the triangles' loads and regimes do not depend on would be accepted and change nothing.
     for (const char* ignored : {"contact.crease_radius_m", "contact.friction_weights",
-                                "contact.friction_zone", "contact.start_gap_m"})
+                                "contact.friction_zone", "contact.start_gap_m", "contact.gamma_n_N_s_per_m3",
+                                "contact.gamma_t_N_s_per_m3", "contact.pin_friction_N_s_per_m"})
       if (key == ignored)
         throw dcm::SceneError("--set " + s + ": " + key +
                               " does not change the contact loads this probe reports (the crease, the "
@@ -97,6 +98,10 @@ void probe(const std::string& path, const std::vector<std::string>& sets, bool a
                 node_load(t, 2) + 0.0,
                 area_c(t));  // + 0.0: no "-0" in the CSV
   }
+  // The CSV is the output: a write that failed (a full disk, a closed file) must not end in exit 0.
+  if (std::fflush(stdout) != 0 || std::ferror(stdout))
+    throw dcm::IoError(
+        "standard output: the write failed (a full disk or a closed file?); the CSV is incomplete");
 }
 
 }  // namespace

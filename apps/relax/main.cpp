@@ -62,7 +62,7 @@ std::string short_seconds(double t) {  // for messages: 0.0563, not 0.0562740000
 
 void run(const AppOptions& options, const RelaxOptions& ro) {
   // Without a scene file: the paper's experiment, a 2562-node Evans-Fung cell with Table 1 constants.
-  const Scene scene = load_scene(options, {"name=relax", "mesh.shape=evans_fung"});
+  const Scene scene = load_scene(options, {"name=relax", "mesh.shape=evans_fung"}, true);
   if (!(ro.hold_force_pN > 0 && ro.hold_force_pN <= 1e4))
     throw SceneError("--hold-force-pN = " + detail::format_real(ro.hold_force_pN) +
                      " is out of range: allowed > 0 .. 10000");

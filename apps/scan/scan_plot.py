@@ -76,9 +76,12 @@ def series(out, mid):
 
 
 def main():
-    if len(sys.argv) != 2 or sys.argv[1] in ("-h", "--help"):
+    if len(sys.argv) == 2 and sys.argv[1] in ("-h", "--help"):
         print(__doc__)
-        sys.exit(0 if len(sys.argv) == 2 else 2)
+        sys.exit(0)
+    if len(sys.argv) != 2:
+        print("scan_plot.py: error: give one scan output folder (usage: scan_plot.py OUT_DIR)", file=sys.stderr)
+        sys.exit(2)
     out = sys.argv[1]
     try:
         scan = json.load(open(os.path.join(out, "scan.json")))

@@ -41,7 +41,7 @@ struct StretchOptions {
 
 void run(const AppOptions& options, const StretchOptions& so) {
   // Without a scene file: the paper's experiment, a 2562-node Evans-Fung cell with Table 1 constants.
-  const Scene scene = load_scene(options, {"name=stretch", "mesh.shape=evans_fung"});
+  const Scene scene = load_scene(options, {"name=stretch", "mesh.shape=evans_fung"}, true);
   if (so.forces_pN.empty())
     throw SceneError(
         "--forces-pN is empty: give at least one force, 0 .. 10000 pN (e.g. --forces-pN 0,50,100)");
