@@ -102,6 +102,9 @@ void run(const Options& o) {
   const dcm::HostMesh sphere = dcm::cell_mesh_from_scene(scene);
   dcm::CortexModel<Exec> model(Exec(), {dcm::HostCell(sphere)}, params);
   model.set_flat_bending_rest();
+  // The icosphere's own volume (the constructor's geometry, before the squash): the rest volume the target
+  // scales.
+  const double mesh_volume = dcm::to_host_vector(model.geometry().cell_volume)[0];
   {
     auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), model.positions());
     for (std::size_t i = 0; i < x.extent(0); ++i) x(i, 2) *= o.squash;
@@ -132,15 +135,6 @@ void run(const Options& o) {
   const double reduced = 6 * std::sqrt(pi) * volume / std::pow(area, 1.5);
   // The volume reached against the target, both as fractions of the icosphere mesh's own volume (the rest
   // volume the target scales; 3.4% below 4/3 π R³ on 162 nodes): a soft volume term stops short of it.
-  double mesh_volume = 0;
-  for (const dcm::Tri& t : sphere.triangles) {
-    const auto& a = sphere.nodes[t[0]];
-    const auto& b = sphere.nodes[t[1]];
-    const auto& cc = sphere.nodes[t[2]];
-    mesh_volume += (a[0] * (b[1] * cc[2] - b[2] * cc[1]) + a[1] * (b[2] * cc[0] - b[0] * cc[2]) +
-                    a[2] * (b[0] * cc[1] - b[1] * cc[0])) /
-                   6;
-  }
   const double fraction = volume / mesh_volume;
   // Symmetry axis: z (the squash direction); centre: the node centroid.
   const int n = o.nodes;
@@ -218,14 +212,15 @@ void run(const Options& o) {
       .add("evans_fung_reduced_volume", 0.644);
   json.write(o.out + "/summary.json");
   if (std::fabs(fraction / o.volume_fraction - 1) > 0.01)
-    std::fprintf(
-        stderr,
-        "deflate: warning: the volume reached V/V_sphere = %.3f, not the target %.3f: the volume term "
-        "(cortex.k_v = %.3g) is too soft against the area terms to deflate the cell that far\n",
-        fraction, o.volume_fraction, scene.get_real("cortex.k_v"));
+    std::fprintf(stderr,
+                 "deflate: warning: the volume reached V/V0 = %.3f (V0 the icosphere's), not the target "
+                 "%.3f: the volume term "
+                 "(cortex.k_v = %.3g) is too soft against the area terms to deflate the cell that far\n",
+                 fraction, o.volume_fraction, scene.get_real("cortex.k_v"));
   if (!o.quiet)
     std::printf(
-        "deflate: %d nodes, V/V_sphere -> %.3f from a start squashed to %.2f: %d Newton steps; reduced "
+        "deflate: %d nodes, V/V0 -> %.3f (V0 the icosphere's) from a start squashed to %.2f: %d Newton "
+        "steps; reduced "
         "volume "
         "%.3f, area %.4f of the sphere's, diameter %.2f um, thickness %.2f um at the centre, %.2f um at rho "
         "= "

@@ -49,8 +49,8 @@ void run(const AppOptions& options, const StretchOptions& so) {
     const double f = so.forces_pN[i];
     if (!(f >= 0 && f <= 1e4))
       throw SceneError("--forces-pN = " + detail::format_real(f) + " is out of range: allowed 0 .. 10000");
-    for (std::size_t j = 0; j < i;
-         ++j)  // each frame is timed by its force: two frames at one time in ParaView
+    // each frame is timed by its force: a repeated force gives two frames at one time in ParaView
+    for (std::size_t j = 0; j < i; ++j)
       if (so.forces_pN[j] == f)
         throw SceneError("--forces-pN = " + detail::format_real(f) +
                          " is given twice: allowed each force once (stretch.xmf times its frames by F)");
