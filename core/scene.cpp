@@ -476,14 +476,22 @@ void Scene::set(const std::string& key_equals_value) {
     (nodes_now ? nodes_by_set_ : subdivisions_by_set_) = true;
   }
   assign(key, canonical, true);
+  by_set_.insert(key);
   if (key == kNodes || key == kSubdivisions) follow_mesh_size(key);
+}
+
+const std::string& Scene::origin_of(std::initializer_list<const char*> keys) const {
+  static const std::string set_origin = kSetOrigin;
+  for (const char* k : keys)
+    if (by_set_.count(k) != 0) return set_origin;
+  return origin_;
 }
 
 void Scene::validate() const {
   // The name is a folder under out/: a path in it wrote outside out/ (name = "../../escape", session 41).
   if (name_.find('/') != std::string::npos || name_.find('\\') != std::string::npos || name_ == "." ||
       name_ == "..")
-    fail(origin_,
+    fail(origin_of({"name"}),
          "name = '" + name_ +
              "' is not allowed: a folder name under out/ (no '/' or '\\', not '.' or '..'); to write "
              "elsewhere set output.dir or --out");
@@ -491,8 +499,9 @@ void Scene::validate() const {
   const bool sphere = get_string("mesh.shape") == "sphere";
   const double radius = sphere ? get_real("mesh.radius_m") : get_real("mesh.diameter_m") / 2;
   if (!(h0 < radius)) {
-    fail(origin_, "contact.h0_m = " + format_real(h0) + " must be smaller than the cell radius " +
-                      (sphere ? "mesh.radius_m" : "mesh.diameter_m/2") + " = " + format_real(radius));
+    fail(origin_of({"contact.h0_m", "mesh.shape", "mesh.radius_m", "mesh.diameter_m"}),
+         "contact.h0_m = " + format_real(h0) + " must be smaller than the cell radius " +
+             (sphere ? "mesh.radius_m" : "mesh.diameter_m/2") + " = " + format_real(radius));
   }
 }
 

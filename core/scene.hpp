@@ -11,7 +11,9 @@
 //   scenes/x.toml: mesh.subdivisions = 9 is out of range: allowed 0 .. 6
 //   scenes/x.toml: unknown key 'mesh.radus' (did you mean 'mesh.radius_m'?)
 //   scenes/x.toml: mesh.radius_m = "big" has the wrong type: expected a real number (m)
+#include <initializer_list>
 #include <map>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -73,11 +75,14 @@ class Scene {
   std::map<std::string, std::string> values_;  // key -> canonical value text
   std::map<std::string, bool> set_;
   bool nodes_by_set_ = false, subdivisions_by_set_ = false;  // mesh.nodes, mesh.subdivisions given by set()
+  std::set<std::string> by_set_;                             // the keys set() gave (validate()'s label)
 
   // Stores a checked canonical value; "name" also updates name_ (empty: the name from origin_).
   void assign(const std::string& key, const std::string& canonical, bool given);
   // Keeps mesh.nodes and mesh.subdivisions consistent after `key` (one of them) was assigned.
   void follow_mesh_size(const std::string& key);
+  // The label of a cross-key error about `keys`: "--set" when set() gave one of them, else origin_.
+  const std::string& origin_of(std::initializer_list<const char*> keys) const;
 };
 
 // The schema as Markdown (a table per section) for docs/SCENES.md and --help-scene.

@@ -490,9 +490,23 @@ TEST(SceneValidate, H0BelowCellRadius) {
 
   Scene s = Scene::defaults();
   s.set("mesh.radius_m=1e-8");
-  EXPECT_THROW(s.validate(), SceneError);
+  // The value came from --set, not from the defaults: the message says so.
+  try {
+    s.validate();
+    ADD_FAILURE() << "a 10-nm cell with h0 = 20 nm validated";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("--set: contact.h0_m = ", 0), 0U) << e.what();
+  }
   s.set("mesh.radius_m=1e-6");
   EXPECT_NO_THROW(s.validate());
+  Scene named = Scene::defaults();
+  named.set("name=a/b");
+  try {
+    named.validate();
+    ADD_FAILURE() << "a name with a path validated";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("--set: name = 'a/b' is not allowed", 0), 0U) << e.what();
+  }
 }
 
 // ---- output --------------------------------------------------------------------------------------

@@ -39,6 +39,9 @@ void run(const AppOptions& options) {
   const Scene scene = load_scene(options);
   if (stop_after_check("geometry", options, scene)) return;
   const std::string out = prepare_output_dir(options, scene);
+  // An earlier run's files go first: one that cannot be replaced (a folder in its place) stops the run
+  // before it writes anything (it wrote geometry.json and .h5 and then failed on the .xmf until session 42).
+  remove_earlier_outputs(out, {"geometry.json", "geometry.h5", "geometry.xmf", "geometry.xmf.tmp"});
   KokkosSession kokkos(options.threads);
   using Exec = Kokkos::DefaultExecutionSpace;
   using Mem = Exec::memory_space;
