@@ -182,6 +182,17 @@ std::vector<ParamSpec> make_schema() {
           "dcm's experiment (session 34): the fillet radius ρ of the membrane leaving the plane; each rim "
           "edge stores W ρ |e| tan(turn/2) per wing, the adhesion a sharp fold loses against the fillet "
           "(kernels/contact_crease.hpp; √(√3 k_b/4W) = 1.02e-8 m for Table 1; 0: off)"),
+      real_key(
+          "contact.guard_depth_m", "100e-9", 0, 1e-5, kIncl, "m",
+          "the substrate guard (dcm's, session 42; kernels/substrate_guard.hpp): nodes deeper than this "
+          "below the plane are pushed back (with contact.guard_stiffness_Pa_per_m > 0). Keep it deeper "
+          "than the depth at which the contact law holds a bound membrane: about 30 nm for Table 1, 0.2 um "
+          "with W = 0.1 J/m²"),
+      real_key(
+          "contact.guard_stiffness_Pa_per_m", "0", 0, 1e20, kIncl, "Pa/m",
+          "the guard's pressure per metre past contact.guard_depth_m; 0: off (the paper's model). 2.5e13 "
+          "= 10 W/h0² for Table 1: the Dugdale stress W/h0 at h0/10 past the depth. For membrane that "
+          "folds into the substrate where the contact law does not act (spread warns)"),
 
       real_key(
           "time.dt_s", "6e-6", 0, 1, kExcl, "s",

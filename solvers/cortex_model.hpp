@@ -28,6 +28,7 @@
 #include "kernels/fene_pow_bonds.hpp"
 #include "kernels/membrane_forces.hpp"
 #include "kernels/plane_contact.hpp"
+#include "kernels/substrate_guard.hpp"
 #include "kernels/volume_constraint.hpp"
 #include "solvers/bending_stiffness.hpp"
 #include "solvers/breakdown_diagnosis.hpp"
@@ -71,6 +72,9 @@ struct MechanicsParams {
   double gamma_n = 0, gamma_t = 0;
   double pin_friction = 0;   // N·s/m on nodes fully in contact (the paper's pinning); 0: off
   double crease_radius = 0;  // m, the fillet at the contact line (kernels/contact_crease.hpp); 0: off
+  // The substrate guard (kernels/substrate_guard.hpp): nodes deeper than guard_depth below the plane are
+  // pushed back with guard_stiffness (Pa/m) per metre past it; guard_stiffness = 0: off.
+  double guard_depth = 0, guard_stiffness = 0;
   bool lumped_friction =
       true;  // substrate friction w_i Γ_t per node (false: β_i β_j Γ_t), friction_operator.hpp
   bool area_friction_weights = true;  // lumped: w_i from the friction area's centroid (false: the load's)
@@ -117,6 +121,7 @@ inline std::string batch_mismatch(const MechanicsParams& a, const MechanicsParam
       {"substrate friction on/off", on(a.gamma_n) != on(b.gamma_n) || on(a.gamma_t) != on(b.gamma_t) ||
                                         on(a.pin_friction) != on(b.pin_friction)},
       {"the crease at the contact line on/off", on(a.crease_radius) != on(b.crease_radius)},
+      {"the substrate guard on/off", on(a.guard_stiffness) != on(b.guard_stiffness)},
       {"the membrane pass (fused or per term)", a.fused_membrane != b.fused_membrane},
       {"lumped substrate friction",
        a.lumped_friction != b.lumped_friction || a.area_friction_weights != b.area_friction_weights},
@@ -196,6 +201,19 @@ class CortexModel {
         for (const MechanicsParams& q : cell_params_)
           laws.push_back(CreaseLaw{q.contact.material.W, q.contact.material.h0, q.crease_radius, p.plane});
         crease_ = PerCell<CreaseLaw, Mem>(laws, "dcm::model::crease");
+      }
+      if (p.guard_stiffness > 0) {  // each cell's own depth and stiffness (on in every cell or in none)
+        std::vector<SubstrateGuard> guards;
+        for (const MechanicsParams& q : cell_params_)
+          guards.push_back(SubstrateGuard{q.guard_depth, q.guard_stiffness, p.plane});
+        guard_ = PerCell<SubstrateGuard, Mem>(guards, "dcm::model::guard");
+        // Each node's area in the start shape: fixed, so that the guard's force is its energy's gradient.
+        guard_area_ =
+            Kokkos::View<double*, Kokkos::LayoutRight, Mem>("dcm::model::guard_area", mesh_.n_nodes);
+        Kokkos::deep_copy(space_, guard_area_, geo_.node_area);
+        guard_k_ = Kokkos::View<double*, Kokkos::LayoutRight, Mem>("dcm::model::guard_k", mesh_.n_nodes);
+        guard_dt_ = Kokkos::View<double*, Kokkos::LayoutRight, Mem>("dcm::model::guard_k_dt", mesh_.n_nodes);
+        friction_.substrate_normal = (1.0 / norm(p.plane.normal)) * p.plane.normal;
       }
     }
     for (const MechanicsParams& q : cell_params_)
@@ -393,6 +411,7 @@ class CortexModel {
       add_plane_contact_forces(space_, mesh_, params_.plane, *contact_, force_);
     }
     if (crease_) add_crease_forces(space_, mesh_, crease_->table(), force_);
+    if (guard_) add_substrate_guard_forces(space_, mesh_, guard_->table(), guard_area_, force_, guard_k_);
     const int bad_node = first_non_finite_node(space_, force_);
     if (bad_node >= 0)
       throw NumericalError("non-finite force at node " + std::to_string(bad_node) +
@@ -430,6 +449,7 @@ class CortexModel {
     if (volume_) add(volume_energy(space_, mesh_, geo_, *volume_, k_volume_.table(), out), e);
     // the contact line's crease, counted with the cortex
     if (crease_) add(crease_energy(space_, mesh_, crease_->table(), out), e);
+    if (guard_) add(substrate_guard_energy(space_, mesh_, guard_->table(), guard_area_, out), e);
     return e;
   }
 
@@ -481,6 +501,18 @@ class CortexModel {
           });
     } else {
       friction_.bond_stiffness_dt = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
+    }
+    if (guard_ && dt > 0) {  // the substrate guard linearly implicit: Δt k_g A_i n̂n̂ᵀ where it acts
+      const auto k = guard_k_;
+      const auto k_dt = guard_dt_;
+      const auto node_cell = mesh_.node_cell;
+      const auto step = dt_.table();
+      Kokkos::parallel_for(
+          "dcm::model::implicit_guard", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_nodes),
+          KOKKOS_LAMBDA(const int i) { k_dt(i) = cell_value(step, node_cell(i)) * k(i); });
+      friction_.node_guard = guard_dt_;
+    } else {
+      friction_.node_guard = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
     }
     update_friction(space_, mesh_, friction_, !multigrid_.has_value());  // the multigrid inverts its own
     const bool implicit_tension = dt > 0 && tension_stiffness_.has_value();
@@ -641,12 +673,26 @@ class CortexModel {
       text += std::string(" (the term at fault: ") +
               (not_finite ? "not finite first at node " : "lowest at node ") + std::to_string(node) + ")";
     };
-    FrictionOperator<Mem> gamma = friction_;  // Γ alone, without the implicit bond stiffness
+    FrictionOperator<Mem> gamma = friction_;  // Γ alone, without the implicit bond and guard stiffness
     gamma.bond_stiffness_dt = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
+    gamma.node_guard = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
     apply_friction(space_, mesh_, gamma, p, q);
     term("friction (drag, dashpots, substrate)", q);
+    if (last_solve_implicit_ && friction_.node_guard.extent(0) > 0) {
+      FrictionOperator<Mem> guarded = gamma;
+      guarded.node_guard = friction_.node_guard;
+      apply_friction(space_, mesh_, guarded, p, z);
+      Kokkos::parallel_for(
+          "dcm::model::breakdown_guard", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_nodes),
+          KOKKOS_LAMBDA(const int i) {
+            for (int d = 0; d < 3; ++d) z(i, d) -= q(i, d);
+          });
+      term("implicit substrate guard", z);
+    }
     if (last_solve_implicit_ && friction_.bond_stiffness_dt.extent(0) > 0) {
-      apply_friction(space_, mesh_, friction_, p, z);
+      FrictionOperator<Mem> bonded = friction_;
+      bonded.node_guard = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
+      apply_friction(space_, mesh_, bonded, p, z);
       Kokkos::parallel_for(
           "dcm::model::breakdown_bonds", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_nodes),
           KOKKOS_LAMBDA(const int i) {
@@ -706,8 +752,9 @@ class CortexModel {
 
   // vᵀ Γ v: the power dissipated by the friction (W), for the energy balance.
   double dissipation(std::vector<double>* per_cell = nullptr) {
-    FrictionOperator<Mem> gamma = friction_;  // Γ alone, without the implicit bond stiffness
+    FrictionOperator<Mem> gamma = friction_;  // Γ alone, without the implicit bond and guard stiffness
     gamma.bond_stiffness_dt = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
+    gamma.node_guard = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
     apply_friction(space_, mesh_, gamma, velocity_, cg_.q);
     if (!per_cell) return cg_detail::dot(space_, cg_.sums, velocity_, cg_.q, "dcm::model::dissipation");
     cg_detail::segment_dots(space_, cg_.sums, velocity_, cg_.q, *per_cell, "dcm::model::dissipation");
@@ -816,6 +863,10 @@ class CortexModel {
       return;
     if (crease_ &&
         term("contact crease", [&] { add_crease_forces(space_, mesh_, crease_->table(), scratch); }))
+      return;
+    if (guard_ && term("substrate guard", [&] {
+          add_substrate_guard_forces(space_, mesh_, guard_->table(), guard_area_, scratch, guard_k_);
+        }))
       return;
   }
 
@@ -930,7 +981,11 @@ class CortexModel {
   std::optional<TensionStiffness<Mem>> tension_stiffness_;
   std::optional<Vector> gravity_;
   std::optional<ContactBuffers<Mem>> contact_;
-  std::optional<PerCell<CreaseLaw, Mem>> crease_;  // per cell; empty: off
+  std::optional<PerCell<CreaseLaw, Mem>> crease_;      // per cell; empty: off
+  std::optional<PerCell<SubstrateGuard, Mem>> guard_;  // per cell; empty: off
+  // The guard's fixed node areas A_i, its k_g A_i where it acts (compute_forces()) and Δt k_g A_i (the
+  // solve).
+  Kokkos::View<double*, Kokkos::LayoutRight, Mem> guard_area_, guard_k_, guard_dt_;
   // The curvature and the rounded triangles' spheres are updated each step only for the paper's contact law
   // (core/update_geometry.hpp); refresh_curvature() brings them up to date for output.
   bool rounded_geometry_ = true;

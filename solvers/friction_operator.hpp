@@ -17,6 +17,9 @@
 // velocity, w_ti = max(β_ti, 0) / Σ_k max(β_tk, 0): the same force on a rigidly moving triangle, but every
 // node in contact is damped, not only the contact point; diagonal blocks only (docs/model/spread.md).
 //
+// The substrate guard (kernels/substrate_guard.hpp), taken linearly implicit: node_guard(i) n̂n̂ᵀ on node i's
+// diagonal block, node_guard(i) = Δt k_g A_i where the guard acts (0 elsewhere; empty View: no guard).
+//
 // Coefficients (n̂_b and each node's 3×3 diagonal block, inverted for the block-Jacobi preconditioner)
 // are cached once per step by update(); apply() is a gather over each node's bonds (no atomics).
 // Expectations (tests/test_solver.cpp): symmetric (uᵀΓw = wᵀΓu) and positive (vᵀΓv > 0) on random
@@ -57,6 +60,8 @@ struct FrictionOperator {
   // Pinning (the paper's option): nodes whose triangles all lie fully in the contact get pin_friction I.
   double pin_friction = 0;  // N·s/m; 0: off
   View<int*> tri_regime;    // ContactRegime per triangle (shared with the contact buffers)
+  // The substrate guard's Δt k_g A_i per node along substrate_normal (N·s/m); empty: none.
+  View<double*> node_guard;
 
   // The coefficients the kernels read, per cell: c, c_t, γ_n, γ_t, pin (FrictionCoef). update_friction()
   // fills them from the scalars above, or from cell_rows when set (a batch of cells with different
@@ -194,9 +199,12 @@ struct SubstrateBlocks {
   View<int*> tri_offsets, corners, regime;
   View<double* [3]> beta;
   View<double*> area;
+  View<double*> guard;  // FrictionOperator::node_guard (empty: none)
 
   KOKKOS_INLINE_FUNCTION void add_block(int i, int j, double blk[6]) const {
-    if (!on || (lumped && i != j)) return;  // lumped: diagonal blocks only
+    if (i == j && guard.extent(0) > 0 && guard(i) > 0)
+      add_dashpot_block(normal, guard(i), 0.0, 1.0, blk);  // the substrate guard, Δt k_g A_i n̂n̂ᵀ
+    if (!on || (lumped && i != j)) return;                 // lumped: diagonal blocks only
     const int cell = node_cell(i);
     const double gamma_n = coef(cell, kGammaN), gamma_t = coef(cell, kGammaT), pin = coef(cell, kPin);
     for (int q = tri_offsets(i); q < tri_offsets(i + 1); ++q) {
@@ -239,6 +247,7 @@ SubstrateBlocks<MemorySpace> substrate_blocks(const MeshBuffers<MemorySpace>& me
   s.regime = op.tri_regime;
   s.beta = op.tri_beta;
   s.area = op.tri_contact_area;
+  s.guard = op.node_guard;
   return s;
 }
 
@@ -309,6 +318,8 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
   const bool stiff = bond_k.extent(0) > 0;
   const auto contact_area = op.tri_contact_area;
   const Real3 sn = op.substrate_normal;
+  const auto guard = op.node_guard;
+  const bool guarded = guard.extent(0) > 0;
   if (substrate && !lumped) {  // u_t = Γ_t Σ_j β_tj v_j for the triangles in contact
     const auto tri = mesh.tri;
     Kokkos::parallel_for(
@@ -357,6 +368,7 @@ void apply_friction(const ExecutionSpace& space, const MeshBuffers<MemorySpace>&
         }
         const double pin = coef(cell, kPin);
         if (pin > 0 && node_fully_in_contact(i, tri_offsets, corners, regime)) acc += pin * vi;
+        if (guarded && guard(i) > 0) acc += (guard(i) * dot(sn, vi)) * sn;  // the substrate guard
         store3(out, i, acc);
       });
 }

@@ -78,7 +78,7 @@ void expect_same_values(const Scene& a, const Scene& b, const std::vector<std::s
 
 TEST(SceneSchema, KeysAreUniqueAndDefaultsLieInTheirRange) {
   const auto& schema = scene_schema();
-  ASSERT_EQ(schema.size(), 62u);
+  ASSERT_EQ(schema.size(), 64u);
   for (size_t i = 0; i < schema.size(); ++i) {
     for (size_t j = i + 1; j < schema.size(); ++j) EXPECT_NE(schema[i].key, schema[j].key);
     EXPECT_FALSE(schema[i].doc.empty()) << schema[i].key;

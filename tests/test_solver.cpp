@@ -110,6 +110,50 @@ TEST(FrictionOperator, SubstrateBlocksMatchAssemblyAndKeepGammaSymmetricPositive
   EXPECT_LT((Eigen::Map<const Eigen::VectorXd>(xh.data(), xh.size()) - ref).norm(), 1e-8 * ref.norm());
 }
 
+// The substrate guard taken implicit (FrictionOperator::node_guard, kernels/substrate_guard.hpp): g_i n̂n̂ᵀ on
+// the diagonal block of the nodes where it acts, on top of the substrate blocks. Γ matches its assembly plus
+// those blocks from their definition, stays symmetric positive definite, and PCG with the block-Jacobi
+// diagonal (which carries the guard) agrees with Eigen's dense solve.
+TEST(FrictionOperator, SubstrateGuardAddsNormalBlocksOnItsNodes) {
+  FrictionSetup s(2);
+  s.enable_random_substrate(9);
+  const Eigen::MatrixXd without = s.assemble();
+  const int n = s.mesh.n_nodes;
+  Kokkos::View<double*, Kokkos::LayoutRight, Mem> guard("guard", n);
+  auto gh = Kokkos::create_mirror_view(guard);
+  for (int i = 0; i < n; ++i)
+    gh(i) = i % 3 == 0 ? 1e-4 * (1 + i % 7) : 0.0;  // a third of the nodes, as strong as the substrate
+  Kokkos::deep_copy(guard, gh);
+  s.op.node_guard = guard;
+  update_friction(Exec(), s.mesh, s.op);
+  const Eigen::Vector3d nn = Eigen::Vector3d(0.2, -0.1, 1.0).normalized();  // the random substrate's normal
+  Eigen::MatrixXd a = without;
+  for (int i = 0; i < n; ++i) a.block<3, 3>(3 * i, 3 * i) += gh(i) * nn * nn.transpose();
+  const Vector v = s.random_vector(33);
+  const auto vh = to_host_vector(v), gv = to_host_vector(s.apply(v));
+  const Eigen::VectorXd expected = a * Eigen::Map<const Eigen::VectorXd>(vh.data(), vh.size());
+  const Eigen::VectorXd got = Eigen::Map<const Eigen::VectorXd>(gv.data(), gv.size());
+  EXPECT_LT((got - expected).norm(), 1e-12 * expected.norm());
+  const Eigen::VectorXd plain = without * Eigen::Map<const Eigen::VectorXd>(vh.data(), vh.size());
+  EXPECT_GT((got - plain).norm(), 1e-3 * plain.norm()) << "the guard is switched on";
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a, Eigen::EigenvaluesOnly);
+  EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0);
+  const Vector f = s.random_vector(43, 1e-12);
+  const auto fh = to_host_vector(f);
+  const Eigen::VectorXd ref = a.llt().solve(Eigen::Map<const Eigen::VectorXd>(fh.data(), fh.size()));
+  Vector x("x", n);
+  CgWorkspace<Mem> ws(n);
+  CgSettings cg;
+  cg.abs_tol = 0;
+  cg.rel_tol = 1e-12;
+  const CgResult r = pcg_solve(
+      Exec(), [&](const Vector& in, const Vector& out) { apply_friction(Exec(), s.mesh, s.op, in, out); },
+      [&](const Vector& in, const Vector& out) { apply_block_jacobi(Exec(), s.op, in, out); }, f, x, ws, cg);
+  EXPECT_TRUE(r.converged);
+  const auto xh = to_host_vector(x);
+  EXPECT_LT((Eigen::Map<const Eigen::VectorXd>(xh.data(), xh.size()) - ref).norm(), 1e-8 * ref.norm());
+}
+
 // Lumped substrate friction (contact.friction_weights = lumped): w_ti Γ_t on each node's own velocity. It
 // matches its assembly, is diagonal in the nodes (block-Jacobi is exact for it), keeps Γ symmetric positive,
 // and a rigid translation feels the same substrate force as with the consistent blocks (Σ w = Σ β = 1).

@@ -62,6 +62,8 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
     p.gamma_t = scene.get_real("contact.gamma_t_N_s_per_m3");
     p.pin_friction = scene.get_real("contact.pin_friction_N_s_per_m");
     p.crease_radius = scene.get_real("contact.crease_radius_m");
+    p.guard_depth = scene.get_real("contact.guard_depth_m");
+    p.guard_stiffness = scene.get_real("contact.guard_stiffness_Pa_per_m");
     p.lumped_friction = scene.get_string("contact.friction_weights") != "consistent";
     p.area_friction_weights = scene.get_string("contact.friction_weights") == "area";
   }

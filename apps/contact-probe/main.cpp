@@ -39,13 +39,14 @@ void probe(const std::string& path, const std::vector<std::string>& sets, bool a
                             ": only contact.*, geometry.*, cortex.E_Pa and cortex.nu may change "
                             "(the shape is the checkpoint's)");
     // Keys the triangles' loads and regimes do not depend on would be accepted and change nothing.
-    for (const char* ignored : {"contact.crease_radius_m", "contact.friction_weights",
-                                "contact.friction_zone", "contact.start_gap_m", "contact.gamma_n_N_s_per_m3",
-                                "contact.gamma_t_N_s_per_m3", "contact.pin_friction_N_s_per_m"})
+    for (const char* ignored :
+         {"contact.crease_radius_m", "contact.friction_weights", "contact.friction_zone",
+          "contact.start_gap_m", "contact.gamma_n_N_s_per_m3", "contact.gamma_t_N_s_per_m3",
+          "contact.pin_friction_N_s_per_m", "contact.guard_depth_m", "contact.guard_stiffness_Pa_per_m"})
       if (key == ignored)
         throw dcm::SceneError("--set " + s + ": " + key +
                               " does not change the contact loads this probe reports (the crease, the "
-                              "substrate friction and the start gap act elsewhere)");
+                              "substrate friction, the guard and the start gap act elsewhere)");
     scene.set(s);
   }
   scene.validate();
@@ -131,7 +132,11 @@ int main(int argc, char** argv) {
   app.add_option("CHECKPOINT", path, "checkpoint.h5 written by spread")->required();
   app.add_option("--set", sets, "KEY=VALUE: change a contact.*, geometry.*, cortex.E_Pa or cortex.nu key")
       ->allow_extra_args(false);
-  app.add_flag("--all", all, "every triangle, also those without contact");
+  app.add_flag(
+      "--all", all,
+      "every triangle; without it, those whose rounded sphere reaches within h0 of the plane (regime "
+      ">= 1, the gap branch included: a small sphere of a wall triangle can reach the plane while the "
+      "triangle itself lies far above it)");
   int threads = 0;
   app.add_option("--threads", threads, "Host threads (default: OMP_NUM_THREADS, else all cores)")
       ->check(CLI::Range(0, 4096));

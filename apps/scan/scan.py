@@ -330,6 +330,8 @@ def write_h5(scan, out, rows):
             for k in SUMMARY_KEYS + ["warnings"]:
                 if row.get(k, "") != "":
                     mg.attrs[k] = row[k]
+            if row["warnings"] != "":  # the summary was read: its null values (not measured), by name
+                mg.attrs["null_keys"] = json.dumps([k for k in SUMMARY_KEYS if row.get(k, "") == ""])
             src_path = os.path.join(out, "members", m["id"], "spread.h5")
             if not os.path.isfile(src_path) or not results_of(os.path.dirname(src_path), m):
                 continue

@@ -204,12 +204,22 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   // membrane that buckles or folds over at the rim can pass into it: 0.34 um with soft area terms and Table
   // 1's bending, 0.41 um at the biconcave cell's rim on 642 nodes, session 40);
   if (deep > 0) {
+    const double guard_depth = m.scene.get_real("contact.guard_depth_m");
+    const bool guarded = m.scene.get_real("contact.guard_stiffness_Pa_per_m") > 0;
+    char remedy[200];
+    if (guarded)
+      std::snprintf(remedy, sizeof remedy,
+                    "the substrate guard holds it near contact.guard_depth_m = %.3g um", guard_depth * 1e6);
+    else
+      std::snprintf(remedy, sizeof remedy,
+                    "the shape near those nodes is not physical; contact.guard_stiffness_Pa_per_m = 2.5e13 "
+                    "pushes it back past contact.guard_depth_m = %.3g um",
+                    guard_depth * 1e6);
     std::snprintf(text, sizeof text,
                   "%d node(s) end up to %.3g um below the plane, more than 3 times the bound membrane's "
                   "typical depth (%.3g um): the membrane folds into the substrate there, which the contact "
-                  "pushes back only where its triangles face the plane; the shape near those nodes is not "
-                  "physical",
-                  deep, (m.plane_z - zlow) * 1e6, depth_typical * 1e6);
+                  "pushes back only where its triangles face the plane; %s",
+                  deep, (m.plane_z - zlow) * 1e6, depth_typical * 1e6, remedy);
     warnings.emplace_back(text);
   }
   // no step moved the cell (every CG solve stopped at once: the forces were below the absolute tolerance);
@@ -228,6 +238,16 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
         "the cell lost its contact (r_cc reached %.3g um, 0 at the end): the steps do not resolve the "
         "contact; use time.adaptive = true or a smaller time.dt_s",
         r_most * 1e6);
+    warnings.emplace_back(text);
+  }
+  // the cell never touched the plane (a run that ended while it was still falling or too far to adhere: every
+  // fit is null, and nothing else would say why; session 42, found by a helper's review);
+  if (!(r_most > 0) && !(r_final > 0) && done > 0 && !m.interrupted && !m.stopped_at_max_steps) {
+    std::snprintf(text, sizeof text,
+                  "the cell never touched the plane (r_cc stayed 0 up to t = %.4g s): nothing spread and the "
+                  "fits are null; run longer (time.t_end_s) or start closer (contact.start_gap_m below "
+                  "contact.h0_m)",
+                  t);
     warnings.emplace_back(text);
   }
   // and a fixed-step run of a few steps (time.dt_s near t_end), which nothing above can judge.

@@ -538,11 +538,13 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
                   m.so.max_steps, short_time(stepper.time(m.cell)).c_str(), m.checkpoint_path.c_str());
   for (const Member& m : ms)
     if (m.interrupted)
-      throw AppInterrupted("interrupted at t = " + short_time(stepper.time(m.cell)) + " s; " + m.out_dir +
-                           "/" + (m.h5 ? "spread.h5, " : "") +
-                           "series.csv and summary.json hold what was done; continue with: spread "
-                           "--restart " +
-                           m.checkpoint_path);
+      throw AppInterrupted(
+          "interrupted at t = " + short_time(stepper.time(m.cell)) + " s; " + m.out_dir + "/" +
+          (m.h5 ? "spread.h5, " : "") +
+          "series.csv and summary.json hold what was done; continue with: spread "
+          "--restart " +
+          m.checkpoint_path +
+          (m.h5 ? "; plots of it: python3 scripts/plot_spread.py " + m.out_dir : std::string()));
 }
 
 }  // namespace spread_app
