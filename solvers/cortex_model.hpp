@@ -678,7 +678,14 @@ class CortexModel {
     gamma.node_guard = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
     apply_friction(space_, mesh_, gamma, p, q);
     term("friction (drag, dashpots, substrate)", q);
+    double guard_max = 0;  // a guard that acts nowhere adds exactly 0 W: not a term at fault
     if (last_solve_implicit_ && friction_.node_guard.extent(0) > 0) {
+      const auto g = friction_.node_guard;
+      Kokkos::parallel_reduce(
+          "dcm::model::breakdown_guard_max", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_nodes),
+          KOKKOS_LAMBDA(const int i, double& m) { m = g(i) > m ? g(i) : m; }, Kokkos::Max<double>(guard_max));
+    }
+    if (guard_max > 0) {
       FrictionOperator<Mem> guarded = gamma;
       guarded.node_guard = friction_.node_guard;
       apply_friction(space_, mesh_, guarded, p, z);

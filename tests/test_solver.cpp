@@ -136,6 +136,17 @@ TEST(FrictionOperator, SubstrateGuardAddsNormalBlocksOnItsNodes) {
   EXPECT_LT((got - expected).norm(), 1e-12 * expected.norm());
   const Eigen::VectorXd plain = without * Eigen::Map<const Eigen::VectorXd>(vh.data(), vh.size());
   EXPECT_GT((got - plain).norm(), 1e-3 * plain.norm()) << "the guard is switched on";
+  // The block-Jacobi preconditioner inverts each node's diagonal block, guard included.
+  const auto inv = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), s.op.block_inverse);
+  double worst_inverse = 0;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Matrix3d blk = a.block<3, 3>(3 * i, 3 * i).inverse();
+    const double got_inv[6] = {inv(i, 0), inv(i, 1), inv(i, 2), inv(i, 3), inv(i, 4), inv(i, 5)};
+    const double want[6] = {blk(0, 0), blk(1, 1), blk(2, 2), blk(0, 1), blk(0, 2), blk(1, 2)};
+    for (int k = 0; k < 6; ++k)
+      worst_inverse = std::max(worst_inverse, std::abs(got_inv[k] - want[k]) / blk.norm());
+  }
+  EXPECT_LT(worst_inverse, 1e-10);
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a, Eigen::EigenvaluesOnly);
   EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0);
   const Vector f = s.random_vector(43, 1e-12);

@@ -53,49 +53,60 @@ struct Sunk {
   }
 };
 
+// On the plane z = 0 and on a tilted one (normal (0.3, −0.2, 2), not unit: the kernel normalises it): the
+// force is k_g A_i e_i n̂ on the nodes past the guard depth, 0 elsewhere, and the energy's exact gradient.
 TEST(SubstrateGuard, ForcesAreTheEnergyGradientAndActOnlyPastTheDepth) {
-  const Sunk s(0.6e-6);
-  const SubstrateGuard g = guard();
-  Vector force("force", s.mesh.n_nodes);
-  Scalars k("k", s.mesh.n_nodes);
-  add_substrate_guard_forces(Exec(), s.mesh, g, s.area, force, k);
-  const auto f = to_host_vector(force), kh = to_host_vector(k), a = to_host_vector(s.area);
-  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), s.mesh.x);
-  int acting = 0;
-  double worst = 0, fmax = 0;
-  for (int i = 0; i < s.mesh.n_nodes; ++i) {
-    const double excess = -x(i, 2) - kDepth;
-    if (excess > 0) {
-      ++acting;
-      EXPECT_DOUBLE_EQ(kh[i], kStiff * a[i]) << "node " << i;
-      EXPECT_NEAR(f[3 * i + 2], kStiff * a[i] * excess, 1e-12 * kStiff * a[i] * excess) << "node " << i;
-    } else {
-      EXPECT_EQ(kh[i], 0.0) << "node " << i;
-      EXPECT_EQ(f[3 * i + 2], 0.0) << "node " << i << " above the guard depth";
+  for (const Real3 normal : {Real3{0, 0, 2}, Real3{0.3, -0.2, 2}}) {
+    const Sunk s(0.6e-6);
+    SubstrateGuard g = guard();
+    g.plane.normal = normal;
+    const Real3 nh = (1.0 / norm(normal)) * normal;
+    Vector force("force", s.mesh.n_nodes);
+    Scalars k("k", s.mesh.n_nodes);
+    add_substrate_guard_forces(Exec(), s.mesh, g, s.area, force, k);
+    const auto f = to_host_vector(force), kh = to_host_vector(k), a = to_host_vector(s.area);
+    auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), s.mesh.x);
+    int acting = 0;
+    double worst = 0, fmax = 0;
+    for (int i = 0; i < s.mesh.n_nodes; ++i) {
+      const double excess = -dot(Real3{x(i, 0), x(i, 1), x(i, 2)}, nh) - kDepth;
+      const double expected = excess > 0 ? kStiff * a[i] * excess : 0.0;
+      if (excess > 0) {
+        ++acting;
+        EXPECT_DOUBLE_EQ(kh[i], kStiff * a[i]) << "node " << i;
+      } else {
+        EXPECT_EQ(kh[i], 0.0) << "node " << i;
+      }
+      const double along[3] = {nh.x, nh.y, nh.z};
+      for (int d = 0; d < 3; ++d) {
+        if (excess > 0)
+          EXPECT_NEAR(f[3 * i + d], expected * along[d], 1e-12 * expected)
+              << "node " << i << " component " << d;
+        else
+          EXPECT_EQ(f[3 * i + d], 0.0) << "node " << i << " above the guard depth";
+        fmax = std::max(fmax, std::abs(f[3 * i + d]));
+        const double step = 1e-3 * kDepth, x0 = x(i, d);
+        x(i, d) = x0 + step;
+        Kokkos::deep_copy(s.mesh.x, x);
+        const double ep = substrate_guard_energy(Exec(), s.mesh, g, s.area);
+        x(i, d) = x0 - step;
+        Kokkos::deep_copy(s.mesh.x, x);
+        const double em = substrate_guard_energy(Exec(), s.mesh, g, s.area);
+        x(i, d) = x0;
+        worst = std::max(worst, std::abs(-(ep - em) / (2 * step) - f[3 * i + d]));
+      }
     }
-    EXPECT_EQ(f[3 * i], 0.0);
-    EXPECT_EQ(f[3 * i + 1], 0.0);
-    fmax = std::max(fmax, std::abs(f[3 * i + 2]));
-    for (int d = 0; d < 3; ++d) {
-      const double step = 1e-3 * kDepth, x0 = x(i, d);
-      x(i, d) = x0 + step;
-      Kokkos::deep_copy(s.mesh.x, x);
-      const double ep = substrate_guard_energy(Exec(), s.mesh, g, s.area);
-      x(i, d) = x0 - step;
-      Kokkos::deep_copy(s.mesh.x, x);
-      const double em = substrate_guard_energy(Exec(), s.mesh, g, s.area);
-      x(i, d) = x0;
-      worst = std::max(worst, std::abs(-(ep - em) / (2 * step) - f[3 * i + d]));
-    }
+    Kokkos::deep_copy(s.mesh.x, x);
+    // The bottom 0.5 µm past the guard depth: the nodes of the lowest rings.
+    EXPECT_GE(acting, 6);
+    EXPECT_LT(acting, 40);
+    EXPECT_GT(fmax, 0.0);
+    EXPECT_LT(worst, 1e-6 * fmax);
+    std::printf(
+        "  normal (%g, %g, %g): %d of 162 nodes past the guard depth, largest force %.3g N, worst "
+        "difference %.3g N\n",
+        normal.x, normal.y, normal.z, acting, fmax, worst);
   }
-  Kokkos::deep_copy(s.mesh.x, x);
-  // The bottom 0.5 µm past the guard depth: the nodes of the lowest rings.
-  EXPECT_GE(acting, 6);
-  EXPECT_LT(acting, 40);
-  EXPECT_GT(fmax, 0.0);
-  EXPECT_LT(worst, 1e-6 * fmax);
-  std::printf("  %d of 162 nodes past the guard depth, largest force %.3g N, worst difference %.3g N\n",
-              acting, fmax, worst);
 }
 
 TEST(SubstrateGuard, ABoundMembraneAboveTheDepthFeelsNothing) {

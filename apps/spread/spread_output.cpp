@@ -205,16 +205,23 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   // 1's bending, 0.41 um at the biconcave cell's rim on 642 nodes, session 40);
   if (deep > 0) {
     const double guard_depth = m.scene.get_real("contact.guard_depth_m");
-    const bool guarded = m.scene.get_real("contact.guard_stiffness_Pa_per_m") > 0;
-    char remedy[200];
-    if (guarded)
+    const double guard_k = m.scene.get_real("contact.guard_stiffness_Pa_per_m");
+    // 10 W/h0²: the Dugdale stress W/h0 at h0/10 past the guard depth (2.5e13 Pa/m for Table 1)
+    const double suggested = 10 * m.scene.get_real("contact.W_J_per_m2") / (m.h0 * m.h0);
+    char remedy[240];
+    if (guard_k > 0 && m.plane_z - zlow <= 1.5 * guard_depth)
       std::snprintf(remedy, sizeof remedy,
                     "the substrate guard holds it near contact.guard_depth_m = %.3g um", guard_depth * 1e6);
+    else if (guard_k > 0)
+      std::snprintf(remedy, sizeof remedy,
+                    "the substrate guard (contact.guard_stiffness_Pa_per_m = %.3g) is too soft to hold it at "
+                    "contact.guard_depth_m = %.3g um: raise it (10 W/h0^2 = %.3g)",
+                    guard_k, guard_depth * 1e6, suggested);
     else
       std::snprintf(remedy, sizeof remedy,
-                    "the shape near those nodes is not physical; contact.guard_stiffness_Pa_per_m = 2.5e13 "
-                    "pushes it back past contact.guard_depth_m = %.3g um",
-                    guard_depth * 1e6);
+                    "the shape near those nodes is not physical; contact.guard_stiffness_Pa_per_m = %.3g (10 "
+                    "W/h0^2) pushes it back past contact.guard_depth_m = %.3g um",
+                    suggested, guard_depth * 1e6);
     std::snprintf(text, sizeof text,
                   "%d node(s) end up to %.3g um below the plane, more than 3 times the bound membrane's "
                   "typical depth (%.3g um): the membrane folds into the substrate there, which the contact "
