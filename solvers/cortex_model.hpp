@@ -685,27 +685,25 @@ class CortexModel {
           "dcm::model::breakdown_guard_max", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_nodes),
           KOKKOS_LAMBDA(const int i, double& m) { m = g(i) > m ? g(i) : m; }, Kokkos::Max<double>(guard_max));
     }
+    // An implicit part of the friction operator alone: (Γ + the part) p − Γ p.
+    const auto friction_part = [&](const char* name, const FrictionOperator<Mem>& with_part) {
+      apply_friction(space_, mesh_, with_part, p, z);
+      Kokkos::parallel_for(
+          "dcm::model::breakdown_part", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_nodes),
+          KOKKOS_LAMBDA(const int i) {
+            for (int d = 0; d < 3; ++d) z(i, d) -= q(i, d);
+          });
+      term(name, z);
+    };
     if (guard_max > 0) {
       FrictionOperator<Mem> guarded = gamma;
       guarded.node_guard = friction_.node_guard;
-      apply_friction(space_, mesh_, guarded, p, z);
-      Kokkos::parallel_for(
-          "dcm::model::breakdown_guard", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_nodes),
-          KOKKOS_LAMBDA(const int i) {
-            for (int d = 0; d < 3; ++d) z(i, d) -= q(i, d);
-          });
-      term("implicit substrate guard", z);
+      friction_part("implicit substrate guard", guarded);
     }
     if (last_solve_implicit_ && friction_.bond_stiffness_dt.extent(0) > 0) {
-      FrictionOperator<Mem> bonded = friction_;
-      bonded.node_guard = Kokkos::View<double*, Kokkos::LayoutRight, Mem>();
-      apply_friction(space_, mesh_, bonded, p, z);
-      Kokkos::parallel_for(
-          "dcm::model::breakdown_bonds", Kokkos::RangePolicy<ExecutionSpace>(space_, 0, mesh_.n_nodes),
-          KOKKOS_LAMBDA(const int i) {
-            for (int d = 0; d < 3; ++d) z(i, d) -= q(i, d);
-          });
-      term("implicit bonds", z);
+      FrictionOperator<Mem> bonded = gamma;
+      bonded.bond_stiffness_dt = friction_.bond_stiffness_dt;
+      friction_part("implicit bonds", bonded);
     }
     const auto fresh = [&]() {
       Kokkos::deep_copy(space_, q, 0.0);

@@ -22,6 +22,24 @@ double dot_host(const std::vector<double>& a, const std::vector<double>& b) {
   return s;
 }
 
+// PCG on Γ v = f (block-Jacobi) against Eigen's dense solve of the assembled Γ = a, f random (seed).
+void expect_pcg_matches_eigen(const FrictionSetup& s, const Eigen::MatrixXd& a, unsigned seed) {
+  const Vector f = s.random_vector(seed, 1e-12);
+  const auto fh = to_host_vector(f);
+  const Eigen::VectorXd ref = a.llt().solve(Eigen::Map<const Eigen::VectorXd>(fh.data(), fh.size()));
+  Vector x("x", s.mesh.n_nodes);
+  CgWorkspace<Mem> ws(s.mesh.n_nodes);
+  CgSettings cg;
+  cg.abs_tol = 0;
+  cg.rel_tol = 1e-12;
+  const CgResult r = pcg_solve(
+      Exec(), [&](const Vector& in, const Vector& out) { apply_friction(Exec(), s.mesh, s.op, in, out); },
+      [&](const Vector& in, const Vector& out) { apply_block_jacobi(Exec(), s.op, in, out); }, f, x, ws, cg);
+  EXPECT_TRUE(r.converged);
+  const auto xh = to_host_vector(x);
+  EXPECT_LT((Eigen::Map<const Eigen::VectorXd>(xh.data(), xh.size()) - ref).norm(), 1e-8 * ref.norm());
+}
+
 TEST(FrictionOperator, SymmetricAndPositiveOnRandomVectors) {
   const FrictionSetup s(3);
   for (unsigned seed = 1; seed <= 5; ++seed) {
@@ -94,20 +112,7 @@ TEST(FrictionOperator, SubstrateBlocksMatchAssemblyAndKeepGammaSymmetricPositive
             1e-12 * expected.norm());
   EXPECT_LT((a - a.transpose()).norm(), 1e-14 * a.norm());
   // PCG (block-Jacobi with the substrate diagonal) against Eigen's dense solve.
-  const Vector f = s.random_vector(41, 1e-12);
-  const auto fh = to_host_vector(f);
-  const Eigen::VectorXd ref = a.llt().solve(Eigen::Map<const Eigen::VectorXd>(fh.data(), fh.size()));
-  Vector x("x", s.mesh.n_nodes);
-  CgWorkspace<Mem> ws(s.mesh.n_nodes);
-  CgSettings cg;
-  cg.abs_tol = 0;
-  cg.rel_tol = 1e-12;
-  const CgResult r = pcg_solve(
-      Exec(), [&](const Vector& in, const Vector& out) { apply_friction(Exec(), s.mesh, s.op, in, out); },
-      [&](const Vector& in, const Vector& out) { apply_block_jacobi(Exec(), s.op, in, out); }, f, x, ws, cg);
-  EXPECT_TRUE(r.converged);
-  const auto xh = to_host_vector(x);
-  EXPECT_LT((Eigen::Map<const Eigen::VectorXd>(xh.data(), xh.size()) - ref).norm(), 1e-8 * ref.norm());
+  expect_pcg_matches_eigen(s, a, 41);
 }
 
 // The substrate guard taken implicit (FrictionOperator::node_guard, kernels/substrate_guard.hpp): g_i n̂n̂ᵀ on
@@ -149,20 +154,7 @@ TEST(FrictionOperator, SubstrateGuardAddsNormalBlocksOnItsNodes) {
   EXPECT_LT(worst_inverse, 1e-10);
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a, Eigen::EigenvaluesOnly);
   EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0);
-  const Vector f = s.random_vector(43, 1e-12);
-  const auto fh = to_host_vector(f);
-  const Eigen::VectorXd ref = a.llt().solve(Eigen::Map<const Eigen::VectorXd>(fh.data(), fh.size()));
-  Vector x("x", n);
-  CgWorkspace<Mem> ws(n);
-  CgSettings cg;
-  cg.abs_tol = 0;
-  cg.rel_tol = 1e-12;
-  const CgResult r = pcg_solve(
-      Exec(), [&](const Vector& in, const Vector& out) { apply_friction(Exec(), s.mesh, s.op, in, out); },
-      [&](const Vector& in, const Vector& out) { apply_block_jacobi(Exec(), s.op, in, out); }, f, x, ws, cg);
-  EXPECT_TRUE(r.converged);
-  const auto xh = to_host_vector(x);
-  EXPECT_LT((Eigen::Map<const Eigen::VectorXd>(xh.data(), xh.size()) - ref).norm(), 1e-8 * ref.norm());
+  expect_pcg_matches_eigen(s, a, 43);
 }
 
 // Lumped substrate friction (contact.friction_weights = lumped): w_ti Γ_t on each node's own velocity. It
