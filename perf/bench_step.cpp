@@ -43,6 +43,7 @@
 #include "apps/common/stretch_setup.hpp"
 #include "core/kokkos_compat.hpp"
 #include "core/scene.hpp"
+#include "solvers/cortex_model_impl.hpp"  // the model on Kokkos::Serial too (--serial)
 
 #if defined(KOKKOS_ENABLE_OPENMP) && defined(_OPENMP)
 #include <omp.h>

@@ -24,11 +24,24 @@ if [ "$preset" = cuda ]; then
   dcm_cuda_env
   extra=("-DCMAKE_CXX_COMPILER=$kokkos/bin/nvcc_wrapper")
 fi
-# Configure when there is no build yet, or the preset, the Kokkos or CI-ness (warnings as errors) changed.
-stamp="$preset;$kokkos;ci=${CI:-false}"
+# Ninja (the presets' generator; scripts/deps.sh installs it): unlike Make it compiles a target's files while
+# the libraries the target links are still being built, so the model's one long compile
+# (solvers/cortex_model.cpp, docs/ARCHITECTURE.md "Compile once") runs beside the apps' and tests' files.
+# Without ninja on PATH (DCM_KOKKOS_ROOT set, packages installed by hand): Make.
+generator=Ninja
+if ! command -v ninja > /dev/null; then generator="Unix Makefiles"; fi
+# Configure when there is no build yet, or the preset, the Kokkos, CI-ness (warnings as errors) or the
+# generator changed.
+stamp="$preset;$kokkos;ci=${CI:-false};$generator"
 if [ ! -f "$builddir/CMakeCache.txt" ] || ! grep -qxF "DCM_CONFIGURED_FOR:STRING=$stamp" "$builddir/CMakeCache.txt"; then
+  # CMake cannot switch a build folder to another generator: an earlier one's cache goes (one full build).
+  if [ -f "$builddir/CMakeCache.txt" ] && ! grep -qxF "CMAKE_GENERATOR:INTERNAL=$generator" "$builddir/CMakeCache.txt"; then
+    echo "scripts/build.sh: $builddir was configured for another generator; configuring it for $generator" >&2
+    rm -rf "$builddir/CMakeCache.txt" "$builddir/CMakeFiles"
+  fi
   # -U Kokkos_DIR: a cached Kokkos_DIR from an earlier configure would win over the new Kokkos_ROOT.
-  cmake --preset "$preset" -U Kokkos_DIR -DKokkos_ROOT="$kokkos" "-DDCM_CONFIGURED_FOR:STRING=$stamp" "${extra[@]}" >&2
+  cmake --preset "$preset" -G "$generator" -U Kokkos_DIR -DKokkos_ROOT="$kokkos" \
+    "-DDCM_CONFIGURED_FOR:STRING=$stamp" "${extra[@]}" >&2
 fi
 # A named target that a changed CMakeLists.txt just added needs the build system regenerated first.
 if [ $# -gt 0 ] && [ -n "$(find . -name CMakeLists.txt -newer "$builddir/CMakeCache.txt" -not -path './build*' | head -n 1)" ]; then

@@ -9,7 +9,7 @@
 set -euo pipefail
 
 cache=${DCM_CACHE:-$HOME/.cache/dcm}
-packages=(build-essential cmake pkg-config libeigen3-dev libhdf5-dev hdf5-tools libtomlplusplus-dev
+packages=(build-essential cmake ninja-build pkg-config libeigen3-dev libhdf5-dev hdf5-tools libtomlplusplus-dev
   libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev python3-matplotlib python3-h5py python3-numpy
   dpkg-dev ca-certificates openmpi-bin python3-mpi4py)
 
