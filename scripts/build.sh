@@ -27,16 +27,16 @@ fi
 # Ninja (the presets' generator; scripts/deps.sh installs it): unlike Make it compiles a target's files while
 # the libraries the target links are still being built, so the model's one long compile
 # (solvers/cortex_model.cpp, docs/ARCHITECTURE.md "Compile once") runs beside the apps' and tests' files.
-# Without ninja on PATH (DCM_KOKKOS_ROOT set, packages installed by hand): Make.
 generator=Ninja
-if ! command -v ninja > /dev/null; then generator="Unix Makefiles"; fi
 # Configure when there is no build yet, or the preset, the Kokkos, CI-ness (warnings as errors) or the
 # generator changed.
 stamp="$preset;$kokkos;ci=${CI:-false};$generator"
 if [ ! -f "$builddir/CMakeCache.txt" ] || ! grep -qxF "DCM_CONFIGURED_FOR:STRING=$stamp" "$builddir/CMakeCache.txt"; then
-  # CMake cannot switch a build folder to another generator: an earlier one's cache goes (one full build).
+  # CMake cannot switch a build folder to another generator: an earlier one's cache goes (one full build;
+  # options set there by hand with -D go with it).
   if [ -f "$builddir/CMakeCache.txt" ] && ! grep -qxF "CMAKE_GENERATOR:INTERNAL=$generator" "$builddir/CMakeCache.txt"; then
-    echo "scripts/build.sh: $builddir was configured for another generator; configuring it for $generator" >&2
+    echo "scripts/build.sh: $builddir was configured for another generator (Make, before session 43); its" \
+      "CMakeCache.txt and CMakeFiles/ are removed and it is configured again for $generator (one full build)" >&2
     rm -rf "$builddir/CMakeCache.txt" "$builddir/CMakeFiles"
   fi
   # -U Kokkos_DIR: a cached Kokkos_DIR from an earlier configure would win over the new Kokkos_ROOT.

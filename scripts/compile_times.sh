@@ -25,16 +25,16 @@ fi
 out=$(realpath -m "$1")
 cd "$(dirname "$0")/.."
 root=$(pwd)
-if [ -e "$out" ] && [ ! -f "$out/compile_times.log" ]; then
+if [ -e "$out" ] && [ ! -f "$out/.dcm-compile-times" ]; then
   echo "scripts/compile_times.sh: $out exists and is not an earlier compile_times.sh folder; give a new folder" >&2
   exit 2
 fi
 kokkos=$(DCM_KOKKOS_VARIANT=release bash scripts/deps.sh | tail -n 1)
 rm -rf "$out"
 mkdir -p "$out"
+touch "$out/.dcm-compile-times"  # the mark that lets a later run replace this folder
 log=$out/compile_times.log
-generator=Ninja  # as scripts/build.sh chooses it
-if ! command -v ninja > /dev/null; then generator="Unix Makefiles"; fi
+generator=Ninja  # the presets' generator, as scripts/build.sh uses it
 cmake --preset release -B "$out" -G "$generator" -U Kokkos_DIR -DKokkos_ROOT="$kokkos" \
   "-DCMAKE_CXX_COMPILER_LAUNCHER=$root/scripts/compile_times.sh;--launch;$log" > "$out/configure.log"
 start=$(date +%s)

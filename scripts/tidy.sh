@@ -2,14 +2,14 @@
 # clang-tidy (checks in .clang-tidy: bug-finding and performance, warnings are errors) on dcm's own .cpp files,
 # with the release build's compile_commands.json. Kokkos, Eigen and the other libraries' headers are not
 # checked (HeaderFilterRegex). ctest lint.clang-tidy runs it.
-#   scripts/tidy.sh [FILE...]   (default: every tracked .cpp under core/ and apps/)
+#   scripts/tidy.sh [FILE...]   (default: every tracked .cpp under core/, solvers/ and apps/)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tidy=$(command -v clang-tidy || command -v clang-tidy-14 || true)
 [ -n "$tidy" ] || { echo "scripts/tidy.sh: clang-tidy not found (apt-get install clang-tidy)" >&2; exit 2; }
 [ -f build/compile_commands.json ] || bash scripts/build.sh release > /dev/null
 files=("$@")
-[ ${#files[@]} -gt 0 ] || mapfile -t files < <(git ls-files 'core/*.cpp' 'apps/*.cpp')
+[ ${#files[@]} -gt 0 ] || mapfile -t files < <(git ls-files 'core/*.cpp' 'solvers/*.cpp' 'apps/*.cpp')
 # The build's commands without GCC's switches against gathers (CMakeLists.txt), which clang may refuse.
 db=$(mktemp -d)
 trap 'rm -rf "$db"' EXIT
