@@ -14,6 +14,7 @@
 #include "solvers/multigrid.hpp"
 #include "solvers/pcg.hpp"
 #include "solvers/rigid_modes.hpp"
+#include "tests/dense_reference.hpp"
 #include "tests/friction_setup.hpp"
 
 namespace dcm {
@@ -177,7 +178,7 @@ TEST(Multigrid, CoarseOperatorsAreGalerkinProducts) {
         pm(3 * i + d, 3 * p[2 * i] + d) += 0.5;
         pm(3 * i + d, 3 * p[2 * i + 1] + d) += 0.5;
       }
-    const Eigen::MatrixXd expected = pm.transpose() * fine * pm;
+    const Eigen::MatrixXd expected = test_dense::galerkin_product(pm, fine);
     const Eigen::MatrixXd coarse = dense_blocks(s.mg.levels[l + 1].a);
     EXPECT_LT((coarse - expected).norm(), 1e-12 * expected.norm()) << "level " << l + 1;
     fine = coarse;
@@ -215,8 +216,8 @@ TEST(Multigrid, FineLevelHoldsTheImplicitTension) {
   }
   ASSERT_GT(k.norm(), 0.0) << "the stretched cell is under tension";
   EXPECT_LT((k - k.transpose()).norm(), 1e-12 * k.norm());
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(k, Eigen::EigenvaluesOnly);
-  EXPECT_GT(eig.eigenvalues().minCoeff(), -1e-12 * eig.eigenvalues().maxCoeff());
+  const Eigen::VectorXd eigenvalues = test_dense::symmetric_eigenvalues(k);
+  EXPECT_GT(eigenvalues.minCoeff(), -1e-12 * eigenvalues.maxCoeff());
   Eigen::VectorXd shift(3 * n);
   for (int i = 0; i < n; ++i) shift.segment<3>(3 * i) = Eigen::Vector3d(0.3, -0.2, 0.9);
   EXPECT_LT((k * shift).norm(), 1e-12 * k.norm() * shift.norm());
@@ -302,8 +303,8 @@ TEST(Multigrid, BendingInTheFineLevelIsTheStatedPositiveApproximation) {
   const Eigen::MatrixXd level0 = dense_blocks(s.mg.levels[0].a);
   ASSERT_GT(b.norm(), 1e-3 * gamma.norm()) << "the bending is not negligible in this test";
   EXPECT_LT((level0 - gamma - b).norm(), 1e-12 * level0.norm());
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(level0 - gamma, Eigen::EigenvaluesOnly);
-  EXPECT_GT(eig.eigenvalues().minCoeff(), -1e-12 * eig.eigenvalues().maxCoeff());
+  const Eigen::VectorXd eigenvalues = test_dense::symmetric_eigenvalues(level0 - gamma);
+  EXPECT_GT(eigenvalues.minCoeff(), -1e-12 * eigenvalues.maxCoeff());
   // The V-cycle stays symmetric and positive.
   for (unsigned seed = 1; seed <= 3; ++seed) {
     const Vector u = s.random_vector(seed), v = s.random_vector(seed + 50);
@@ -327,7 +328,7 @@ TEST(Multigrid, BendingInThePreconditionerSavesIterationsWhereItMatters) {
   const Eigen::MatrixXd a = s.exact_operator();
   const Vector f = s.random_vector(11, 1e-12);
   const auto fh = to_host_vector(f);
-  const Eigen::VectorXd ref = a.ldlt().solve(Eigen::Map<const Eigen::VectorXd>(fh.data(), fh.size()));
+  const Eigen::VectorXd ref = test_dense::ldlt_solve(a, fh);
   int its[2];
   for (const bool with : {false, true}) {
     Vector v("v", s.mesh.n_nodes);
@@ -359,7 +360,7 @@ TEST(Multigrid, PcgAgreesWithEigenReferenceOn642Nodes) {
   const Eigen::MatrixXd a = s.assemble();
   const Vector f = s.random_vector(11, 1e-12);
   const auto fh = to_host_vector(f);
-  const Eigen::VectorXd reference = a.llt().solve(Eigen::Map<const Eigen::VectorXd>(fh.data(), fh.size()));
+  const Eigen::VectorXd reference = test_dense::cholesky_solve(a, fh);
   for (auto kind : {Preconditioned::Kind::multigrid, Preconditioned::Kind::rigid}) {
     Vector v("v", s.mesh.n_nodes);
     const CgResult r = s.solve(kind, f, v, 1e-12);
@@ -381,7 +382,7 @@ TEST(Multigrid, WithSubstrateFrictionPcgAgreesWithEigen) {
   const Eigen::MatrixXd a = s.assemble();
   const Vector f = s.random_vector(13, 1e-12);
   const auto fh = to_host_vector(f);
-  const Eigen::VectorXd reference = a.llt().solve(Eigen::Map<const Eigen::VectorXd>(fh.data(), fh.size()));
+  const Eigen::VectorXd reference = test_dense::cholesky_solve(a, fh);
   Vector v("v", s.mesh.n_nodes);
   const CgResult r = s.solve(Preconditioned::Kind::multigrid, f, v, 1e-12);
   Vector w("w", s.mesh.n_nodes);

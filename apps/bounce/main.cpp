@@ -8,6 +8,7 @@
 // nodes_<N>_m: the height of each ball's lowest point) and <out>/bounce.h5
 // + .xmf (the balls and the perfect sphere side by side, --frames-per-bounce frames per bounce: the paper's
 // Video S3 in ParaView).
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
 #include <chrono>

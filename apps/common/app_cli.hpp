@@ -5,7 +5,6 @@
 //   2  bad input (command line, scene file, output folder), nothing written;
 //   3  numerical trouble during a run (step, term and node named);
 //   1  anything else (a bug: please report it).
-#include <CLI/CLI.hpp>
 #include <functional>
 #include <initializer_list>
 #include <stdexcept>
@@ -14,6 +13,12 @@
 
 #include "core/errors.hpp"
 #include "core/scene.hpp"
+
+// CLI11 (CLI/CLI.hpp) costs about 10 s of compile time in every file that includes it; only the apps' main
+// files and app_cli.cpp, which build command lines, include it.
+namespace CLI {
+class App;
+}  // namespace CLI
 
 namespace dcm {
 

@@ -1,5 +1,6 @@
 // geometry: build the scene's cell mesh, compute its geometry on the device, print a report and write
 // <out>/geometry.h5 (+ .xmf for ParaView) and <out>/geometry.json.
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
 #include <cstdio>

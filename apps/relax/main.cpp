@@ -5,6 +5,7 @@
 // with λ∞ the ratio of the unstressed shape. Writes <out>/series.csv (t_s,DA_m,DT_m,energy_J,
 // dissipation_W,cg_iterations), <out>/summary.json (relaxation_time_s, ...), <out>/relax.h5 (+ .xmf) and
 // <out>/relax.png (scripts/plot_relax.py).
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
 #include <cstdio>

@@ -28,6 +28,8 @@
 // per-cell constants, CG and time steps. Each member's folder gets exactly the files its run alone writes,
 // with the same numbers (wall_s excepted: the batch's). Members must need the same kernels and settings
 // (mesh size, solver and time-step options); the first difference is named.
+#include <CLI/CLI.hpp>
+
 #include "apps/spread/spread_app.hpp"
 
 namespace dcm {

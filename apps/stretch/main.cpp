@@ -6,6 +6,7 @@
 // <out>/stretch.h5 (+ .xmf) with one frame per force (the frame's "time" is the force in pN: ParaView's time
 // control steps through the forces and reads them in pN; the series group holds series.csv's columns), and
 // <out>/stretch.png against ../shared/data/stretching when plotting is available.
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
