@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Builds the unit and I/O tests with AddressSanitizer + UndefinedBehaviorSanitizer (preset sanitize,
 # build-sanitize/, -O1, against the release Kokkos) and runs every one of them: any memory error, leak or
-# undefined behaviour fails the run. Part of scripts/test.sh (CI).
+# undefined behaviour that UBSan checks fails the run (all of -fsanitize=undefined but its null and alignment
+# checks, unless configured with -DDCM_SANITIZE_TYPE_CHECKS=ON: docs/ARCHITECTURE.md, "CI's length").
+# Part of scripts/test.sh (CI).
 #   scripts/sanitize.sh [gtest filter for dcm_unit_tests]   (default: all; dcm_io_tests always run in full)
 # The tests run in two lanes side by side (below): about 2 minutes on 2 cores (session 20). Kokkos' own bounds checks are
 # the debug preset's (scripts/build.sh debug).

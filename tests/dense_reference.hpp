@@ -10,7 +10,7 @@ namespace dcm::test_dense {
 // x with a x = b, a symmetric positive definite (Cholesky, LLᵀ).
 Eigen::VectorXd cholesky_solve(const Eigen::MatrixXd& a, const std::vector<double>& b);
 
-// x with a x = b, a symmetric (LDLᵀ with pivoting: also semi-definite and indefinite a).
+// x with a x = b, a symmetric positive or negative semi-definite (LDLᵀ with pivoting).
 Eigen::VectorXd ldlt_solve(const Eigen::MatrixXd& a, const std::vector<double>& b);
 
 // The eigenvalues of the symmetric a, ascending.
