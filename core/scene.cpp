@@ -126,21 +126,6 @@ std::string quoted(const std::string& s) {
   return out + "\"";
 }
 
-size_t levenshtein(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
-
 // ---- unknown keys --------------------------------------------------------------------------------
 
 // The schema key closest to `key` if it is close enough (distance <= max(2, len/3)), else "".
@@ -150,8 +135,8 @@ std::string closest_key(const std::string& key) {
   std::string best;
   size_t best_distance = limit + 1;
   for (const ParamSpec& s : scene_schema()) {
-    size_t d = levenshtein(key, s.key);
-    if (key.find('.') == std::string::npos) d = std::min(d, levenshtein(key, leaf_of(s.key)));
+    size_t d = edit_distance(key, s.key);
+    if (key.find('.') == std::string::npos) d = std::min(d, edit_distance(key, leaf_of(s.key)));
     if (d < best_distance) {
       best_distance = d;
       best = s.key;
@@ -180,7 +165,7 @@ std::string unknown_key_message(const std::string& key) {
 std::string unknown_table_message(const std::string& table) {
   const std::string head = "unknown table [" + table + "]";
   for (const std::string& sec : schema_sections()) {
-    if (levenshtein(table, sec) <= std::max<size_t>(2, table.size() / 3)) {
+    if (edit_distance(table, sec) <= std::max<size_t>(2, table.size() / 3)) {
       return head + " (did you mean [" + sec + "]?)";
     }
   }
@@ -412,6 +397,21 @@ std::string toml_value(const ParamSpec& spec, const std::string& canonical) {
 }
 
 }  // namespace
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
 
 // ---- Scene ---------------------------------------------------------------------------------------
 

@@ -11,6 +11,7 @@
 //   scenes/x.toml: mesh.subdivisions = 9 is out of range: allowed 0 .. 6
 //   scenes/x.toml: unknown key 'mesh.radus' (did you mean 'mesh.radius_m'?)
 //   scenes/x.toml: mesh.radius_m = "big" has the wrong type: expected a real number (m)
+#include <cstddef>
 #include <initializer_list>
 #include <map>
 #include <set>
@@ -87,6 +88,10 @@ class Scene {
 
 // The schema as Markdown (a table per section) for docs/SCENES.md and --help-scene.
 std::string scene_schema_markdown();
+
+// The number of one-character insertions, deletions and substitutions that turn a into b (Levenshtein): what
+// the "did you mean" hints for scene keys and command-line options measure.
+std::size_t edit_distance(const std::string& a, const std::string& b);
 
 namespace detail {
 // Shortest of %.15g, %.16g, %.17g that reads back as v exactly; "nan", "inf", "-inf" for non-finite.

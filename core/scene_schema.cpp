@@ -79,7 +79,7 @@ std::vector<ParamSpec> make_schema() {
       string_key(
           "name", "", {},
           "run name; output goes to out/<name> unless output.dir is set (empty: the scene file's stem; "
-          "without a scene file the app's name: spread, stretch, relax, or default for geometry)"),
+          "without a scene file the app's name: spread, stretch, relax, geometry)"),
 
       string_key("mesh.shape", "sphere", {"sphere", "evans_fung"},
                  "sphere = icosphere of radius mesh.radius_m; evans_fung = Evans–Fung biconcave RBC of "

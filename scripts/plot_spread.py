@@ -10,7 +10,8 @@ r_cc.png    contact radius against time on log-log axes with a t^(1/2) guide, th
 cells.png   the cell at the frames nearest t = 0.1, 0.35, 0.9 s, coloured by the normal force per node
             (top, seen from below the plane, where the contact is) and the cortex tension of eq. 1 (bottom,
             seen from above) (paper Figure 6 style); a run that ends before 0.9 s shows the frames nearest
-            the same fractions of its own end time (end × 0.1/0.9, 0.35/0.9, 1), each frame once; the
+            the same fractions of its own end time (end × 0.1/0.9, 0.35/0.9, 1), each frame once and not the
+            start (t = 0) unless it is the only frame; the
             colours span the 98th percentile of |value| and the colour bar's arrows say that values beyond it
             are drawn in its end colours
 side_views.png  side views (x-z) of the cell at the frames nearest t = 0, 0.1, 0.35, 0.9 s and the end
@@ -116,7 +117,10 @@ def plot_cells(out, h5, tri):
     fl = frames(h5)
     end = fl[-1][0]
     times = (0.1, 0.35, 0.9) if end >= 0.9 else tuple(end * f / 0.9 for f in (0.1, 0.35, 0.9))
-    picks = distinct(fl, times)
+    # The start (t = 0, the untouched sphere) only when no later frame is there: a short run's first time
+    # (end × 0.1/0.9) is often nearer t = 0 than the next frame (the main job: 0.022 s with frames every 0.05 s).
+    later = [f for f in fl if f[0] > 0]
+    picks = distinct(later if later else fl, times)
     ncol = len(picks)
     fig = plt.figure(figsize=(4 * ncol, 7.5))
     for row, (field, label, cmap, elev) in enumerate(

@@ -660,23 +660,24 @@ void run(const BounceOptions& o) {
 int main(int argc, char** argv) {
   dcm::BounceOptions o;
   CLI::App app(
-      "bounce: the paper's bouncing-ball test (Text S2 / Video S3). A rigid triangulated ball (icosphere of "
-      "radius "
-      "R, uniform density) falls on the plane; contact is the rounded-triangle Hertz law (W = 0) of "
-      "kernels/plane_contact.hpp. Its rebound heights (lowest point = centre height - R, at each apex) are "
+      "bounce: the paper's bouncing-ball test (Text S2 / Video S3). A rigid triangulated ball (icosphere of\n"
+      "radius R, uniform density) falls on the plane; contact is the rounded-triangle Hertz law (W = 0) of\n"
+      "kernels/plane_contact.hpp. Its rebound heights (lowest point = centre height - R, at each apex) are\n"
       "compared with those of a perfect sphere obeying the same continuum law P = K a^3/R, a^2 = 2 R d - "
-      "d^2. "
-      "Writes <out>/summary.json, <out>/series.csv and <out>/bounce.h5 + bounce.xmf (the balls and the "
-      "perfect "
-      "sphere side by side, for ParaView). Model: docs/model/bounce.md",
+      "d^2.\n"
+      "Writes <out>/summary.json, <out>/series.csv and <out>/bounce.h5 + bounce.xmf (the balls and the\n"
+      "perfect sphere side by side, for ParaView). Model: docs/model/bounce.md",
       "bounce");
   app.footer(
       "Examples:\n  bounce\n  bounce --nodes 162,642 --bounces 1 --out /tmp/b --quiet\n"
       "Exit codes: 0 success, 2 bad input (one line on stderr, nothing written), 3 numerical failure, 1 "
       "internal error.");
   app.add_option("--nodes", o.nodes,
-                 "Icosphere node counts to compare (12, 42, 162, 642, 2562, 10242, 40962)")
+                 "Icosphere node counts to compare, comma-separated (12, 42, 162, 642, 2562, 10242, 40962)")
+      ->type_name("N1,N2,...")
       ->delimiter(',')
+      ->expected(1)  // one comma-separated list per use (the help then shows no "...")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
       ->capture_default_str();
   app.add_option("--bounces", o.bounces, "Number of bounces, 1 .. 20")->capture_default_str();
   app.add_option(
@@ -707,7 +708,7 @@ int main(int argc, char** argv) {
                  "Frames of bounce.h5/.xmf per bounce, 0 .. 1000 / bounces (0: write no bounce.h5)")
       ->capture_default_str();
   app.add_option("--out", o.out_dir, "Output folder")->capture_default_str();
-  app.add_option("--threads", o.threads, "Host threads (default: OMP_NUM_THREADS, else all cores)");
+  app.add_option("--threads", o.threads, "Host threads (0 or not given: OMP_NUM_THREADS, else all cores)");
   app.add_flag("--quiet", o.quiet, "Print only errors");
   return dcm::run_app(app, argc, argv, [&] { dcm::run(o); });
 }

@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
@@ -27,13 +29,17 @@ void add_common_options(CLI::App& app, AppOptions& o, const std::vector<std::str
   // said "File does not exist: 642"; Scene::from_file names a missing file itself.
   app.add_option("scene", o.scene_path, "Scene file (TOML); without one the built-in defaults run");
   app.add_option("--set", o.sets,
-                 "Override a scene key, e.g. --set mesh.nodes=642 --set mesh.shape=evans_fung (repeatable; "
-                 "--list-keys shows every key)")
+                 "Override a scene key; one KEY=VALUE per --set, repeat it for more: --set mesh.nodes=642 "
+                 "--set mesh.shape=evans_fung (--list-keys shows every key)")
       ->type_name("KEY=VALUE")
-      ->allow_extra_args(false);  // one value per --set: a scene file after it stays the scene file
+      // One value per --set (the help then shows no "..."), every --set kept, and a scene file after it stays
+      // the scene file.
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->allow_extra_args(false);
   app.add_option("--out", o.out_dir,
                  "Output folder (default: the scene's output.dir, else out/<scene name>)");
-  app.add_option("--threads", o.threads, "Host threads (default: OMP_NUM_THREADS, else all cores)")
+  app.add_option("--threads", o.threads, "Host threads (0 or not given: OMP_NUM_THREADS, else all cores)")
       ->check(CLI::Range(0, 4096));
   app.add_flag("--quiet", o.quiet, "Print only errors");
   app.add_flag("--check", o.check,
@@ -47,7 +53,28 @@ void add_common_options(CLI::App& app, AppOptions& o, const std::vector<std::str
       "Print every scene key with its type, default, unit and allowed range, then exit");
 }
 
+namespace {
+
+// A KEY=VALUE or a number where the scene file goes is a value that an option did not take: one key per
+// --set, and an option with several values takes them comma-separated (`stretch --forces-pN 0 50` read 50 as
+// the scene file).
+void check_scene_path(const std::string& path) {
+  if (path.empty() || std::filesystem::exists(path)) return;
+  // `--set a=1 b=2` without a scene file: b=2 lands here.
+  if (path.find('=') != std::string::npos && path.find('/') == std::string::npos)
+    throw SceneError("'" + path + "' was read as the scene file: each scene key needs its own --set (--set " +
+                     path + ")");
+  char* end = nullptr;
+  std::strtod(path.c_str(), &end);
+  if (end != path.c_str() && *end == '\0')
+    throw SceneError("'" + path + "' was read as the scene file: an option with several values takes them " +
+                     "comma-separated, without spaces (e.g. --forces-pN 0,50)");
+}
+
+}  // namespace
+
 Scene load_scene(const AppOptions& o, const std::vector<std::string>& without_file, bool note_defaults) {
+  check_scene_path(o.scene_path);
   Scene scene = o.scene_path.empty() ? Scene::defaults() : Scene::from_file(o.scene_path);
   if (o.scene_path.empty())
     for (const std::string& s : without_file) scene.set(s);
@@ -140,10 +167,58 @@ void remove_earlier_outputs(const std::string& dir, std::initializer_list<const 
   }
 }
 
+std::string program_path(const std::string& name) {
+  std::error_code ec;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec || self.empty() ? name : self.string();
+}
+
+namespace {
+
+// For CLI::ExtrasError: the first unknown option with the nearest known one, else the first stray value.
+std::string unexpected_arguments_message(const CLI::App& app, const std::vector<std::string>& extras) {
+  // An option first (`--ouy x` leaves "--ouy" and "x"): the value after it is the option's.
+  std::string word = extras.empty() ? std::string() : extras.front();
+  for (const std::string& e : extras)
+    if (e.size() > 1 && e[0] == '-' && !std::isdigit(static_cast<unsigned char>(e[1])) && e[1] != '.') {
+      word = e;
+      break;
+    }
+  if (word.size() > 1 && word[0] == '-' && !std::isdigit(static_cast<unsigned char>(word[1]))) {
+    const std::string flag = word.substr(0, word.find('='));
+    std::string best;
+    std::size_t best_distance = std::max<std::size_t>(2, flag.size() / 3) + 1;
+    for (const CLI::Option* opt : app.get_options()) {
+      std::vector<std::string> names;
+      for (const std::string& n : opt->get_lnames()) names.push_back("--" + n);
+      for (const std::string& n : opt->get_snames()) names.push_back("-" + n);
+      for (const std::string& n : names) {
+        const std::size_t d = edit_distance(flag, n);
+        if (d < best_distance) {
+          best_distance = d;
+          best = n;
+        }
+      }
+    }
+    return "unknown option '" + flag + "'" + (best.empty() ? "" : " (did you mean '" + best + "'?)");
+  }
+  if (word.find('=') != std::string::npos)
+    return "unexpected argument '" + word + "': each scene key needs its own --set (--set " + word + ")";
+  return "unexpected argument '" + word +
+         "': one scene file at most, and an option with several values takes them comma-separated";
+}
+
+}  // namespace
+
 int run_app(CLI::App& app, int argc, char** argv, const std::function<void()>& body) {
   const std::string name = app.get_name();
   try {
     app.parse(argc, argv);
+  } catch (const CLI::ExtrasError& e) {
+    // CLI11 says "The following arguments were not expected: x --ouy": name the mistyped option instead.
+    std::cerr << name << ": error: " << unexpected_arguments_message(app, app.remaining())
+              << " (see --help)\n";
+    return 2;
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help (prints it), --list-keys (printed already)
     std::cerr << name << ": error: " << e.what() << " (see --help)\n";

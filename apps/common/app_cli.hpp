@@ -74,6 +74,10 @@ std::string prepare_output_dir(const AppOptions& options, const Scene& scene);
 // early. Throws IoError if one cannot be removed.
 void remove_earlier_outputs(const std::string& dir, std::initializer_list<const char*> names);
 
+// The running app's absolute path (/proc/self/exe), for the commands it suggests ("continue with: ...") to
+// work from any folder; `name` where that cannot be read.
+std::string program_path(const std::string& name);
+
 // Parses the command line and runs body with the failure policy above. Returns the exit code.
 int run_app(CLI::App& app, int argc, char** argv, const std::function<void()>& body);
 

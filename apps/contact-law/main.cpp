@@ -82,15 +82,13 @@ void print_row(const dcm::MdState& st, const Options& o, const dcm::MdMaterial& 
 int main(int argc, char** argv) {
   Options o;
   CLI::App app(
-      "contact-law: the Maugis-Dugdale law of a sphere (radius R) on a rigid plane, one CSV row per --a or "
+      "contact-law: the Maugis-Dugdale law of a sphere (radius R) on a rigid plane, one CSV row per --a or\n"
       "--delta value (in the order given):\n  a_m,delta_m,m,c_m,lambda,Abar,Pbar,P_N\n"
-      "a contact radius, delta geometric overlap (a^2 = 2 R delta - delta^2; negative: gap), m = c/a, c "
-      "adhesive "
-      "radius, lambda Maugis' parameter, Abar = a/(pi W R^2/K)^(1/3), Pbar = P/(pi W R), P net load "
-      "(repulsive > 0). In the gap branch a = 0 and m is empty (undefined; c is 0 beyond h0). With W = 0 "
-      "(Hertz) "
-      "Abar and Pbar are undefined: empty fields (also where W is so small, below ~1e-300, that their units "
-      "underflow).\n"
+      "a contact radius, delta geometric overlap (a^2 = 2 R delta - delta^2; negative: gap), m = c/a,\n"
+      "c adhesive radius, lambda Maugis' parameter, Abar = a/(pi W R^2/K)^(1/3), Pbar = P/(pi W R),\n"
+      "P net load (repulsive > 0). In the gap branch a = 0 and m is empty (undefined; c is 0 beyond h0).\n"
+      "With W = 0 (Hertz) Abar and Pbar are undefined: empty fields (also where W is so small, below\n"
+      "~1e-300, that their units underflow).\n"
       "Model and checks: docs/model/contact.md",
       "contact-law");
   app.footer(

@@ -138,7 +138,7 @@ int main(int argc, char** argv) {
       ">= 1, the gap branch included: a small sphere of a wall triangle can reach the plane while the "
       "triangle itself lies far above it)");
   int threads = 0;
-  app.add_option("--threads", threads, "Host threads (default: OMP_NUM_THREADS, else all cores)")
+  app.add_option("--threads", threads, "Host threads (0 or not given: OMP_NUM_THREADS, else all cores)")
       ->check(CLI::Range(0, 4096));
   return dcm::run_app(app, argc, argv, [&] {
     dcm::KokkosSession kokkos(threads);

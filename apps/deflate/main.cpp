@@ -250,7 +250,7 @@ int main(int argc, char** argv) {
                  "target volume / sphere volume, 0.3 .. 1 (default 0.644)");
   app.add_option("--squash", o.squash, "z scale of the start, 0.1 .. 1 (1: the sphere; default 0.45)");
   app.add_option("--out", o.out, "output folder (default out/deflate)");
-  app.add_option("--threads", o.threads, "host threads (default: OMP_NUM_THREADS, else all cores)")
+  app.add_option("--threads", o.threads, "host threads (0 or not given: OMP_NUM_THREADS, else all cores)")
       ->check(CLI::Range(0, 4096));
   app.add_flag("--quiet", o.quiet, "print only errors");
   app.add_option("--set", o.sets,

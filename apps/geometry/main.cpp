@@ -37,7 +37,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 
 void run(const AppOptions& options) {
-  const Scene scene = load_scene(options);
+  const Scene scene = load_scene(options, {"name=geometry"});  // not out/default, the main job's folder
   if (stop_after_check("geometry", options, scene)) return;
   const std::string out = prepare_output_dir(options, scene);
   // An earlier run's files go first: one that cannot be replaced (a folder in its place) stops the run

@@ -115,7 +115,8 @@ def lhs_range(key, spec):
         raise ScanError(f"sweep.{key} = {spec!r}: mode latin_hypercube samples ranges: give {{start, stop, spacing}}")
     extra = set(spec) - {"start", "stop", "spacing"}
     if extra:
-        what = "the scan's `samples` sets how many members there are" if extra == {"num"} else "allowed: start, stop, spacing"
+        what = ("the scan's `samples` sets how many members there are" if extra == {"num"}
+                else "allowed: start, stop, spacing")
         raise ScanError(f"sweep.{key}: field '{sorted(extra)[0]}' is not used by mode latin_hypercube ({what})")
     start, stop = range_number(key, spec, "start"), range_number(key, spec, "stop")
     spacing = spec.get("spacing", "linear")
@@ -575,22 +576,31 @@ def member_files(out, ids):
     return files
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """A command-line error is one line on stderr and exit code 2, as in every dcm app (argparse prints its usage
+    first)."""
+
+    def error(self, message):
+        sys.stderr.write(f"{self.prog}: error: {message} (see --help)\n")
+        sys.exit(2)
+
+
 def main():
-    ap = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n", 1)[1],
-                                 formatter_class=argparse.RawDescriptionHelpFormatter,
-                                 epilog="Example: scan scans/quick.toml --jobs 2 --threads 1   (4 members of 162 nodes, "
-                                        "under a minute on 2 cores)\n"
-                                        "Scan files: scans/quick.toml, scans/figure5.toml, scans/sensitivity.toml; modes "
-                                        "one_at_a_time, grid\nand latin_hypercube; format in docs/SCANS.md. "
-                                        "Over several machines: mpirun -np P scan SCAN.toml (docs/SCANS.md).")
+    ap = OneLineParser(prog=PROG, description=__doc__.split("\n", 1)[1],
+                       formatter_class=argparse.RawDescriptionHelpFormatter,
+                       epilog="Example: scan scans/quick.toml --jobs 2 --threads 1   (4 members of 162 nodes, "
+                              "under a minute on 2 cores)\n"
+                              "Scan files: scans/quick.toml, scans/figure5.toml, scans/sensitivity.toml; modes "
+                              "one_at_a_time, grid\nand latin_hypercube; format in docs/SCANS.md. "
+                              "Over several machines: mpirun -np P scan SCAN.toml (docs/SCANS.md).")
     ap.add_argument("scan_file", metavar="SCAN.toml")
     ap.add_argument("--out", help="output folder (default out/<scan name>)")
     ap.add_argument("--jobs", type=int, default=0,
-                    help="members run at once (per MPI rank; default: the cores, shared among the ranks on a machine; "
-                         "1 with a GPU build, where one process owns the device: add --chunk N so that its batch "
-                         "fills it)")
+                    help="members run at once (per MPI rank; 0, the default: the cores, shared among the ranks "
+                         "on a machine, whatever OMP_NUM_THREADS says; 1 with a GPU build, where one process owns "
+                         "the device: add --chunk N so that its batch fills it)")
     ap.add_argument("--threads", type=int, default=0,
-                    help="OpenMP threads per member (default: cores / members run at once)")
+                    help="OpenMP threads per member (0, the default: cores / members run at once)")
     ap.add_argument("--chunk", type=int, default=1,
                     help="members run as one batch (spread --batch; default 1: each member its own process)")
     ap.add_argument("--dry-run", action="store_true",

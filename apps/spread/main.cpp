@@ -83,6 +83,7 @@ int main(int argc, char** argv) {
          "and "
          "output.early_window_to_s, 0.01,0.1 unless the scene sets them; a --restart keeps the run's own "
          "unless given)")
+      ->type_name("FROM,TO")
       ->delimiter(',')
       ->expected(2);
   app.add_option(

@@ -380,10 +380,10 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   if (!m.options.quiet && growth >= 0.01 && !m.interrupted && !m.stopped_at_max_steps)
     std::printf(
         "  %snote: r_cc grew %.1f%% over the last tenth of the run (t = %.3g-%.3g s): the cell is still "
-        "spreading, the final values are not those of the spread-out cell; continue with spread --restart "
+        "spreading, the final values are not those of the spread-out cell; continue with %s --restart "
         "'%s' --set time.t_end_s=%g\n",
         m.cell > 0 || !m.so.batch.empty() ? (m.out_dir + ": ").c_str() : "", 100 * growth, 0.9 * t_rows,
-        t_rows, m.checkpoint_path.c_str(), 2 * t);
+        t_rows, program_path("spread").c_str(), m.checkpoint_path.c_str(), 2 * t);
   // The contact front past a node ring that did not come down: the membrane already bound is being stretched
   // outward (docs/model/contact_line.md, "The line held at a node ring").
   if (!m.options.quiet && m.contact_nodes.grew_by_stretching(r_final, m.edge_mean))

@@ -393,9 +393,10 @@ void print_progress(const std::vector<Member>& ms, const Model& model, const Ste
     const Member& m = ms.front();
     const double h = rep[0].h, rate = (m.p.step - m.steps_before) / wall;
     std::printf(
-        "  t = %.4f s  r_cc = %.3f um  dt = %.2g s  CG %d it (last step, all tries)  %.0f steps/s  ETA %.0f "
-        "s\n",
-        stepper.time(0), std::sqrt(model.contact_area() / kPi) * 1e6, h, rep[0].iterations, rate,
+        "  t = %.4f s  r_cc = %.3f um  dt = %.2g s  CG %d it (last step, all tries%s)  %.0f steps/s  ETA "
+        "%.0f s\n",
+        stepper.time(0), std::sqrt(model.contact_area() / kPi) * 1e6, h, rep[0].iterations,
+        rep[0].iterations == 0 ? "; 0: the warm start met the tolerance" : "", rate,
         (m.t_end - stepper.time(0)) / h / rate);
   } else {
     int running = 0;
@@ -534,17 +535,18 @@ void run_members(std::vector<Member>& ms, bool quiet, int threads) {
   // not kill the process before it exits with 130.
   for (const Member& m : ms)
     if (m.stopped_at_max_steps && !m.options.quiet)
-      std::printf("  stopped after --max-steps %lld at t = %s s; continue with: spread --restart %s\n",
-                  m.so.max_steps, short_time(stepper.time(m.cell)).c_str(), m.checkpoint_path.c_str());
+      std::printf("  stopped after --max-steps %lld at t = %s s; continue with: %s --restart %s\n",
+                  m.so.max_steps, short_time(stepper.time(m.cell)).c_str(), program_path("spread").c_str(),
+                  m.checkpoint_path.c_str());
   for (const Member& m : ms)
     if (m.interrupted)
-      throw AppInterrupted(
-          "interrupted at t = " + short_time(stepper.time(m.cell)) + " s; " + m.out_dir + "/" +
-          (m.h5 ? "spread.h5, " : "") +
-          "series.csv and summary.json hold what was done; continue with: spread "
-          "--restart " +
-          m.checkpoint_path +
-          (m.h5 ? "; plots of it: python3 scripts/plot_spread.py " + m.out_dir : std::string()));
+      throw AppInterrupted("interrupted at t = " + short_time(stepper.time(m.cell)) + " s; " + m.out_dir +
+                           "/" + (m.h5 ? "spread.h5, " : "") +
+                           "series.csv and summary.json hold what was done; continue with: " +
+                           program_path("spread") + " --restart " + m.checkpoint_path +
+                           (m.h5 ? "; plots of it: python3 " + std::string(DCM_SOURCE_DIR) +
+                                       "/scripts/plot_spread.py " + m.out_dir
+                                 : std::string()));
 }
 
 }  // namespace spread_app
