@@ -678,6 +678,7 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->expected(1)  // one comma-separated list per use (the help then shows no "...")
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->allow_extra_args(false)
       ->capture_default_str();
   app.add_option("--bounces", o.bounces, "Number of bounces, 1 .. 20")->capture_default_str();
   app.add_option(

@@ -55,20 +55,36 @@ void add_common_options(CLI::App& app, AppOptions& o, const std::vector<std::str
 
 namespace {
 
+// True when `word` is one number or a comma-separated list of numbers ("50", "0,50", "-.5").
+bool is_number_list(const std::string& word) {
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = word.find(',', start);
+    const std::string item =
+        word.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    char* end = nullptr;
+    std::strtod(item.c_str(), &end);
+    if (item.empty() || end == item.c_str() || *end != '\0') return false;
+    if (comma == std::string::npos) return true;
+    start = comma + 1;
+  }
+}
+
 // A KEY=VALUE or a number where the scene file goes is a value that an option did not take: one key per
 // --set, and an option with several values takes them comma-separated (`stretch --forces-pN 0 50` read 50 as
 // the scene file).
 void check_scene_path(const std::string& path) {
-  if (path.empty() || std::filesystem::exists(path)) return;
-  // `--set a=1 b=2` without a scene file: b=2 lands here.
-  if (path.find('=') != std::string::npos && path.find('/') == std::string::npos)
+  std::error_code ec;  // a name too long for the file system is Scene::from_file's to refuse (exit 2)
+  if (path.empty() || std::filesystem::exists(path, ec)) return;
+  // `--set a=1 b=2` without a scene file: b=2 lands here (its value may be a path: output.dir=/tmp/x).
+  const std::size_t eq = path.find('=');
+  if (eq != std::string::npos && eq > 0 && path.substr(0, eq).find('/') == std::string::npos)
     throw SceneError("'" + path + "' was read as the scene file: each scene key needs its own --set (--set " +
                      path + ")");
-  char* end = nullptr;
-  std::strtod(path.c_str(), &end);
-  if (end != path.c_str() && *end == '\0')
-    throw SceneError("'" + path + "' was read as the scene file: an option with several values takes them " +
-                     "comma-separated, without spaces (e.g. --forces-pN 0,50)");
+  if (is_number_list(path))
+    throw SceneError("'" + path +
+                     "' was read as the scene file: a value goes right after its option, and a " +
+                     "list is one word, comma-separated without spaces (e.g. stretch --forces-pN 0,50)");
 }
 
 }  // namespace
@@ -169,43 +185,59 @@ void remove_earlier_outputs(const std::string& dir, std::initializer_list<const 
 
 std::string program_path(const std::string& name) {
   std::error_code ec;
-  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
-  return ec || self.empty() ? name : self.string();
+  std::string self = std::filesystem::read_symlink("/proc/self/exe", ec).string();
+  // A binary rebuilt while it runs reads "<path> (deleted)": the new one is at <path>.
+  const std::string deleted = " (deleted)";
+  if (self.size() > deleted.size() &&
+      self.compare(self.size() - deleted.size(), deleted.size(), deleted) == 0)
+    self.resize(self.size() - deleted.size());
+  return ec || self.empty() ? name : self;
 }
 
 namespace {
 
-// For CLI::ExtrasError: the first unknown option with the nearest known one, else the first stray value.
+// An option, not a value: "--x", "-x"; not "-5", "-.5" or "-".
+bool looks_like_option(const std::string& word) {
+  return word.size() > 1 && word[0] == '-' && !std::isdigit(static_cast<unsigned char>(word[1])) &&
+         word[1] != '.';
+}
+
+// For CLI::ExtrasError: the first unknown option with the nearest known one, else the first stray value, with
+// a hint that fits the app (one with --set, one with a scene file).
 std::string unexpected_arguments_message(const CLI::App& app, const std::vector<std::string>& extras) {
   // An option first (`--ouy x` leaves "--ouy" and "x"): the value after it is the option's.
   std::string word = extras.empty() ? std::string() : extras.front();
   for (const std::string& e : extras)
-    if (e.size() > 1 && e[0] == '-' && !std::isdigit(static_cast<unsigned char>(e[1])) && e[1] != '.') {
+    if (looks_like_option(e)) {
       word = e;
       break;
     }
-  if (word.size() > 1 && word[0] == '-' && !std::isdigit(static_cast<unsigned char>(word[1]))) {
+  if (looks_like_option(word)) {
     const std::string flag = word.substr(0, word.find('='));
+    // Long options only: every two-letter word is one edit from -h.
     std::string best;
-    std::size_t best_distance = std::max<std::size_t>(2, flag.size() / 3) + 1;
-    for (const CLI::Option* opt : app.get_options()) {
-      std::vector<std::string> names;
-      for (const std::string& n : opt->get_lnames()) names.push_back("--" + n);
-      for (const std::string& n : opt->get_snames()) names.push_back("-" + n);
-      for (const std::string& n : names) {
-        const std::size_t d = edit_distance(flag, n);
-        if (d < best_distance) {
-          best_distance = d;
-          best = n;
+    if (flag.size() > 2 && flag[1] == '-') {
+      std::size_t best_distance = std::max<std::size_t>(2, flag.size() / 3) + 1;
+      for (const CLI::Option* opt : app.get_options())
+        for (const std::string& n : opt->get_lnames()) {
+          const std::size_t d = edit_distance(flag, "--" + n);
+          if (d < best_distance) {
+            best_distance = d;
+            best = "--" + n;
+          }
         }
-      }
     }
     return "unknown option '" + flag + "'" + (best.empty() ? "" : " (did you mean '" + best + "'?)");
   }
-  if (word.find('=') != std::string::npos)
+  const bool has_set = app.get_option_no_throw("--set") != nullptr;
+  const bool has_scene = app.get_option_no_throw("scene") != nullptr;
+  if (has_set && word.find('=') != std::string::npos)
     return "unexpected argument '" + word + "': each scene key needs its own --set (--set " + word + ")";
+  if (has_scene)
+    return "unexpected argument '" + word +
+           "': one scene file at most, and an option with several values takes them comma-separated";
   return "unexpected argument '" + word +
-         "': one scene file at most, and an option with several values takes them comma-separated";
+         "': this app takes options only, and an option with several values takes them comma-separated";
 }
 
 }  // namespace
