@@ -51,6 +51,7 @@ struct BounceOptions {
   std::string out_dir = "out/bounce";
   int threads = 0;
   bool quiet = false;
+  bool check = false;  // --check: the options and the output folder only, nothing written or run
 };
 
 // ---- small host-side rigid-body algebra ----
@@ -510,6 +511,11 @@ void validate(const BounceOptions& o) {
 
 void run(const BounceOptions& o) {
   validate(o);
+  if (o.check) {
+    check_output_dir(o.out_dir);
+    if (!o.quiet) std::printf("bounce: ok (checked, nothing written)\n");
+    return;
+  }
   const std::string out =
       prepare_output_dir(AppOptions{"", {}, o.out_dir, o.threads, o.quiet}, Scene::defaults());
   remove_earlier_outputs(out, {"series.csv", "series.csv.tmp", "summary.json", "bounce.h5", "bounce.xmf"});
@@ -711,5 +717,8 @@ int main(int argc, char** argv) {
   app.add_option("--out", o.out_dir, "Output folder")->capture_default_str();
   app.add_option("--threads", o.threads, "Host threads (0 or not given: OMP_NUM_THREADS, else all cores)");
   app.add_flag("--quiet", o.quiet, "Print only errors");
+  app.add_flag(
+      "--check", o.check,
+      "Only check the options and the output folder (exit 0, or 2 with the error); write and run nothing");
   return dcm::run_app(app, argc, argv, [&] { dcm::run(o); });
 }

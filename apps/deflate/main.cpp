@@ -61,6 +61,7 @@ struct Options {
   std::string out = "out/deflate";
   int threads = 0;
   bool quiet = false;
+  bool check = false;             // --check: the options and the output folder only, nothing written or run
   std::vector<std::string> sets;  // cortex.* overrides of the deflation's constants
 };
 
@@ -99,6 +100,10 @@ void run(const Options& o) {
   // The folder is checked before the equilibrium's seconds, as the other apps do, and made after it: a run
   // stopped by Ctrl-C or failing leaves no empty folder and an earlier run's files alone.
   dcm::check_output_dir(o.out);
+  if (o.check) {
+    if (!o.quiet) std::printf("deflate: ok (checked, nothing written)\n");
+    return;
+  }
   const dcm::HostMesh sphere = dcm::cell_mesh_from_scene(scene);
   dcm::CortexModel<Exec> model(Exec(), {dcm::HostCell(sphere)}, params);
   model.set_flat_bending_rest();
@@ -253,10 +258,16 @@ int main(int argc, char** argv) {
   app.add_option("--threads", o.threads, "host threads (0 or not given: OMP_NUM_THREADS, else all cores)")
       ->check(CLI::Range(0, 4096));
   app.add_flag("--quiet", o.quiet, "print only errors");
-  app.add_option("--set", o.sets,
-                 "KEY=VALUE: a cortex.* constant of the deflation (e.g. softer springs: --set "
-                 "cortex.k_s_N_per_m=3.2e-8); default Table 1")
+  app.add_flag(
+      "--check", o.check,
+      "only check the options and the output folder (exit 0, or 2 with the error); write and run nothing");
+  app.add_option(
+         "--set", o.sets,
+         "a cortex.* constant of the deflation, one KEY=VALUE per --set, repeat it for more (e.g. softer "
+         "springs: --set cortex.k_s_N_per_m=3.2e-8); default Table 1")
       ->type_name("KEY=VALUE")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
       ->allow_extra_args(false);
   return dcm::run_app(app, argc, argv, [&] {
     dcm::KokkosSession kokkos(o.threads);
