@@ -244,8 +244,9 @@ int main(int argc, char** argv) {
       "Writes in --out: summary.json (area, volume, reduced volume, diameter, centre and largest thickness,\n"
       "against the Evans-Fung cell), profile.csv (thickness against the distance from the axis), shape.csv\n"
       "(node positions), deflate.h5 + deflate.xmf (the squashed start and the equilibrium, for ParaView).\n"
-      "Examples:\n  deflate                       (642 nodes, a few seconds)\n"
-      "  deflate --nodes 2562 --out out/deflate2562   (minutes)\n"
+      "Run time: a few seconds on 642 nodes (the default), minutes on 2562.\n"
+      "Examples:\n  deflate\n"
+      "  deflate --nodes 2562 --out out/deflate2562\n"
       "Exit codes: 0 success, 2 bad input or an unwritable --out (one line on stderr, nothing written),\n3 "
       "numerical failure (the "
       "Newton iteration did not converge), 1 internal error.");
