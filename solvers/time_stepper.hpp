@@ -209,7 +209,10 @@ class TimeStepper {
           const bool contact_ok = !(q > 0) || rho[c] <= q;
           if ((err <= settings_.error_tol_m && contact_ok) || h_prev_[c] <= settings_.dt_min * (1 + 1e-12)) {
             double next = grow(h_prev_[c], err);
-            if (q > 0 && rho[c] > 0) next = std::min(next, h_prev_[c] * std::max(0.2, 0.9 * q / rho[c]));
+            // The contact-change limit, too, stays within [dt_min, dt_max] (it took steps below dt_min until
+            // session 45, found by a helper's probe of extreme scenes).
+            if (q > 0 && rho[c] > 0)
+              next = std::max(settings_.dt_min, std::min(next, h_prev_[c] * std::max(0.2, 0.9 * q / rho[c])));
             h[c] = std::min(next, h_cap[c]);
             checking[c] = 0;
             continue;
