@@ -678,13 +678,12 @@ int main(int argc, char** argv) {
       "Examples:\n  bounce\n  bounce --nodes 162,642 --bounces 1 --out /tmp/b --quiet\n"
       "Exit codes: 0 success, 2 bad input (one line on stderr, nothing written), 3 numerical failure, 1 "
       "internal error.");
-  app.add_option("--nodes", o.nodes,
-                 "Icosphere node counts to compare, comma-separated (12, 42, 162, 642, 2562, 10242, 40962)")
-      ->type_name("N1,N2,...")
-      ->delimiter(',')
-      ->expected(1)  // one comma-separated list per use (the help then shows no "...")
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
-      ->allow_extra_args(false)
+  dcm::one_value_per_use(
+      app.add_option(
+             "--nodes", o.nodes,
+             "Icosphere node counts to compare, comma-separated (12, 42, 162, 642, 2562, 10242, 40962)")
+          ->type_name("N1,N2,...")
+          ->delimiter(','))
       ->capture_default_str();
   app.add_option("--bounces", o.bounces, "Number of bounces, 1 .. 20")->capture_default_str();
   app.add_option(

@@ -17,6 +17,10 @@
 
 namespace dcm {
 
+CLI::Option* one_value_per_use(CLI::Option* option) {
+  return option->expected(1)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)->allow_extra_args(false);
+}
+
 void add_common_options(CLI::App& app, AppOptions& o, const std::vector<std::string>& examples,
                         bool interruptible) {
   std::string footer = "Examples:\n";
@@ -31,12 +35,8 @@ void add_common_options(CLI::App& app, AppOptions& o, const std::vector<std::str
   app.add_option("--set", o.sets,
                  "Override a scene key; one KEY=VALUE per --set, repeat it for more: --set mesh.nodes=642 "
                  "--set mesh.shape=evans_fung (--list-keys shows every key)")
-      ->type_name("KEY=VALUE")
-      // One value per --set (the help then shows no "..."), every --set kept, and a scene file after it stays
-      // the scene file.
-      ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
-      ->allow_extra_args(false);
+      ->type_name("KEY=VALUE");
+  one_value_per_use(app.get_option("--set"));
   app.add_option("--out", o.out_dir,
                  "Output folder (default: the scene's output.dir, else out/<scene name>)");
   app.add_option("--threads", o.threads, "Host threads (0 or not given: OMP_NUM_THREADS, else all cores)")
@@ -54,6 +54,11 @@ void add_common_options(CLI::App& app, AppOptions& o, const std::vector<std::str
 }
 
 namespace {
+
+// A KEY=VALUE that did not follow a --set of its own.
+std::string own_set_hint(const std::string& word) {
+  return "each scene key needs its own --set (--set " + word + ")";
+}
 
 // True when `word` is one number or a comma-separated list of numbers ("50", "0,50", "-.5").
 bool is_number_list(const std::string& word) {
@@ -79,8 +84,7 @@ void check_scene_path(const std::string& path) {
   // `--set a=1 b=2` without a scene file: b=2 lands here (its value may be a path: output.dir=/tmp/x).
   const std::size_t eq = path.find('=');
   if (eq != std::string::npos && eq > 0 && path.substr(0, eq).find('/') == std::string::npos)
-    throw SceneError("'" + path + "' was read as the scene file: each scene key needs its own --set (--set " +
-                     path + ")");
+    throw SceneError("'" + path + "' was read as the scene file: " + own_set_hint(path));
   if (is_number_list(path))
     throw SceneError("'" + path +
                      "' was read as the scene file: a value goes right after its option, and a " +
@@ -232,7 +236,7 @@ std::string unexpected_arguments_message(const CLI::App& app, const std::vector<
   const bool has_set = app.get_option_no_throw("--set") != nullptr;
   const bool has_scene = app.get_option_no_throw("scene") != nullptr;
   if (has_set && word.find('=') != std::string::npos)
-    return "unexpected argument '" + word + "': each scene key needs its own --set (--set " + word + ")";
+    return "unexpected argument '" + word + "': " + own_set_hint(word);
   if (has_scene)
     return "unexpected argument '" + word +
            "': one scene file at most, and an option with several values takes them comma-separated";

@@ -18,6 +18,7 @@
 // files and app_cli.cpp, which build command lines, include it.
 namespace CLI {
 class App;
+class Option;
 }  // namespace CLI
 
 namespace dcm {
@@ -46,6 +47,11 @@ struct AppOptions {
 // interruptible: the app stops cleanly on Ctrl-C with exit code 130 (spread), which the footer then lists.
 void add_common_options(CLI::App& app, AppOptions& options, const std::vector<std::string>& examples,
                         bool interruptible = false);
+
+// A repeatable option that takes one value (or one comma-separated list, with ->delimiter(',')) per use,
+// keeps every use, and leaves the next word to the positionals (a scene file after it stays the scene file);
+// its help shows no "...", which read as a space-separated list. Returns `option`.
+CLI::Option* one_value_per_use(CLI::Option* option);
 
 // For --check: when it was given, checks the output folder (check_output_dir), prints "<app>: scene <name>:
 // ok (checked, nothing written)" (unless --quiet) and returns true; the app then returns before creating its

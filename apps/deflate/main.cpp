@@ -266,10 +266,8 @@ int main(int argc, char** argv) {
          "--set", o.sets,
          "a cortex.* constant of the deflation, one KEY=VALUE per --set, repeat it for more (e.g. softer "
          "springs: --set cortex.k_s_N_per_m=3.2e-8); default Table 1")
-      ->type_name("KEY=VALUE")
-      ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
-      ->allow_extra_args(false);
+      ->type_name("KEY=VALUE");
+  dcm::one_value_per_use(app.get_option("--set"));
   return dcm::run_app(app, argc, argv, [&] {
     dcm::KokkosSession kokkos(o.threads);
     run(o);

@@ -199,9 +199,8 @@ int main(int argc, char** argv) {
                  "200: 0,15.987,19.338,30.754,38.365,47.245,67.964,87.837,108.949,130.513,150.809,172.374,"
                  "192.688,200)")
       ->type_name("F1,F2,...")
-      ->delimiter(',')
-      ->expected(1)  // one comma-separated list per use (the help then shows no "...")
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
-      ->allow_extra_args(false);  // "--forces-pN 0,50 SCENE": SCENE is the scene file, not a force
+      ->delimiter(',');
+  // "--forces-pN 0,50 SCENE": SCENE is the scene file, not a force
+  dcm::one_value_per_use(app.get_option("--forces-pN"));
   return dcm::run_app(app, argc, argv, [&] { dcm::run(options, so); });
 }
