@@ -91,10 +91,11 @@ void renumber_in_bands(HostMesh& m) {
       }
   if (static_cast<int>(order.size()) != n) throw std::logic_error("icosphere: the mesh is not connected");
   std::vector<Vec3> nodes(n);
-  std::vector<std::array<int, 2>> parents(n, {-1, -1});
+  std::vector<std::array<int, 2>> parents(m.parents.empty() ? 0 : n, {-1, -1});
   for (int i = 0; i < n; ++i) {
     nodes[id[i]] = m.nodes[i];
-    if (m.parents[i][0] >= 0) parents[id[i]] = {id[m.parents[i][0]], id[m.parents[i][1]]};
+    if (!m.parents.empty() && m.parents[i][0] >= 0)
+      parents[id[i]] = {id[m.parents[i][0]], id[m.parents[i][1]]};
   }
   for (Tri& t : m.triangles)
     for (int& v : t) v = id[v];
@@ -108,12 +109,13 @@ void renumber_in_bands(HostMesh& m) {
   m.parents = std::move(parents);
 }
 
-HostMesh unit_icosphere(int subdivisions) {
+HostMesh unit_icosphere(int subdivisions, const BandRefinement& band) {
   if (subdivisions < 0 || subdivisions > 8)
     throw std::invalid_argument("icosphere subdivisions = " + std::to_string(subdivisions) +
                                 " is out of range: allowed 0 .. 8");
   HostMesh m = icosahedron();
   for (int k = 0; k < subdivisions; ++k) subdivide(m);
+  if (band.levels > 0) refine_band(m, band);
   renumber_in_bands(m);
   return m;
 }
@@ -122,9 +124,9 @@ HostMesh unit_icosphere(int subdivisions) {
 
 long long icosphere_node_count(int subdivisions) { return 10LL * (1LL << (2 * subdivisions)) + 2; }
 
-HostMesh make_icosphere(int subdivisions, double radius) {
+HostMesh make_icosphere(int subdivisions, double radius, const BandRefinement& band) {
   if (!(radius > 0)) throw std::invalid_argument("icosphere radius must be positive");
-  HostMesh m = unit_icosphere(subdivisions);
+  HostMesh m = unit_icosphere(subdivisions, band);
   for (auto& x : m.nodes)
     for (double& c : x) c *= radius;
   return m;
@@ -136,9 +138,9 @@ double EvansFungShape::half_thickness(double rho) const {
   return diameter * root * (a0 + a1 * s * s + a2 * s * s * s * s);
 }
 
-HostMesh make_evans_fung(int subdivisions, const EvansFungShape& shape) {
+HostMesh make_evans_fung(int subdivisions, const EvansFungShape& shape, const BandRefinement& band) {
   if (!(shape.diameter > 0)) throw std::invalid_argument("Evans-Fung diameter must be positive");
-  HostMesh m = unit_icosphere(subdivisions);
+  HostMesh m = unit_icosphere(subdivisions, band);
   const double D = shape.diameter;
   for (auto& x : m.nodes) {
     const double r2 = x[0] * x[0] + x[1] * x[1];

@@ -495,6 +495,12 @@ void Scene::validate() const {
          "name = '" + name_ +
              "' is not allowed: a folder name under out/ (no '/' or '\\', not '.' or '..'); to write "
              "elsewhere set output.dir or --out");
+  if (get_int("mesh.refine_levels") > 0 &&
+      !(get_real("mesh.refine_from_deg") < get_real("mesh.refine_to_deg")))
+    fail(origin_of({"mesh.refine_from_deg", "mesh.refine_to_deg", "mesh.refine_levels"}),
+         "mesh.refine_to_deg = " + format_real(get_real("mesh.refine_to_deg")) +
+             " is not allowed: the refined band must end above mesh.refine_from_deg = " +
+             format_real(get_real("mesh.refine_from_deg")));
   const double h0 = get_real("contact.h0_m");
   const bool sphere = get_string("mesh.shape") == "sphere";
   const double radius = sphere ? get_real("mesh.radius_m") : get_real("mesh.diameter_m") / 2;

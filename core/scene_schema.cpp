@@ -90,6 +90,18 @@ std::vector<ParamSpec> make_schema() {
                      "node count (10·4^k+2); an alternative to mesh.subdivisions"),
       real_key("mesh.radius_m", "3.25e-6", 0, 1e-3, kExcl, "m", "radius of the sphere"),
       real_key("mesh.diameter_m", "7.82e-6", 0, 1e-3, kExcl, "m", "Evans–Fung diameter D"),
+      int_key(
+          "mesh.refine_levels", "0", 0, 4,
+          "local refinement: the triangles reaching polar angles mesh.refine_from_deg .. mesh.refine_to_deg "
+          "(from the lowest point, the one that meets the plane) are split 1-to-4 this many more times, each "
+          "level halving the edge there (red-green closure at the border; docs/model/mesh_refinement.md); "
+          "0 = none"),
+      real_key(
+          "mesh.refine_from_deg", "60", 0, 180, kIncl, "deg",
+          "where the refined band starts: polar angle from the lowest point of the sphere (of the sphere "
+          "mapped to the Evans–Fung shape)"),
+      real_key("mesh.refine_to_deg", "100", 0, 180, kIncl, "deg",
+               "where the refined band ends (polar angle from the lowest point); above mesh.refine_from_deg"),
 
       real_key("geometry.h_min_per_m", "1e4", 0, 1e9, kExcl, "1/m",
                "lower clamp of the triangle mean curvature H (the rounded triangles' radius is at most "

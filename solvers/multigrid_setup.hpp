@@ -4,9 +4,11 @@
 // recipe of the Galerkin products A_{l+1} = Pᵀ A_l P (which fine slots, with which weights, sum into each
 // coarse slot). The numeric part, rebuilt every step, is in solvers/multigrid.hpp.
 //
-// Levels: 0 is the mesh; level l holds, for each cell of subdivision k_c, its 10·4^max(k_c−l,0)+2 nodes of
-// subdivision level ≤ max(k_c − l, 0) (HostMesh::parents records the hierarchy; subdivision_levels() derives
-// each node's level), in the order of their mesh indices, so a coarse level keeps the mesh's locality.
+// Levels: 0 is the mesh; level l holds, for each cell of depth k_c (its deepest subdivision level), its nodes
+// of subdivision level ≤ max(k_c − l, 0) (HostMesh::parents records the hierarchy; subdivision_levels()
+// derives each node's level), in the order of their mesh indices, so a coarse level keeps the mesh's
+// locality. On an icosphere of subdivision k_c those are 10·4^max(k_c−l,0)+2 nodes; on a band-refined one
+// (core/band_refinement.cpp) the first levels thin the band only, then the icosphere's follow.
 // Cells are concatenated in the order of the buffers. Every
 // cell reaches the 12 icosahedron nodes on the coarsest level, where a cell already there is carried
 // down unchanged (P = I for it). P sets a midpoint node to the mean of its two parents, per component;
@@ -47,13 +49,6 @@ struct HostHierarchy {
   std::vector<HostTransfer> transfers;  // levels − 1 of them
   int n_cells = 0;
 };
-
-// Subdivision k of a node count 10·4^k + 2, or −1.
-inline int icosphere_level_of(std::size_t n) {
-  for (int k = 0; k <= 8; ++k)
-    if (static_cast<long long>(n) == icosphere_node_count(k)) return k;
-  return -1;
-}
 
 // The diagonal plus every bond (global node indices, as in MeshBuffers::bond).
 inline HostSparsePattern bond_pattern(int n_nodes, const std::vector<int>& bond_pairs,
@@ -153,11 +148,13 @@ inline HostTransfer make_transfer(const HostSparsePattern& fine, std::vector<std
 }
 
 // Each node's subdivision level (0: an icosahedron node, else 1 + the larger of its parents' levels) from
-// HostMesh::parents, or an empty vector when they do not describe the icosphere hierarchy of subdivision k
-// (the nodes of level <= j must number 10·4^j + 2 for every j <= k).
-inline std::vector<int> subdivision_levels(const HostMesh& m, int k) {
+// HostMesh::parents, or an empty vector when they do not describe a subdivision hierarchy of the icosahedron:
+// a cycle of parents, a node with one parent, other than 12 nodes on level 0, or more nodes of level <= j
+// than the icosphere of subdivision j has. A band-refined icosphere (core/band_refinement.cpp) has fewer
+// on its finest levels; the coarsening needs only that every node's parents lie on the coarser levels.
+inline std::vector<int> subdivision_levels(const HostMesh& m) {
   const int n = static_cast<int>(m.nodes.size());
-  if (k < 0 || static_cast<int>(m.parents.size()) != n) return {};
+  if (n == 0 || static_cast<int>(m.parents.size()) != n) return {};
   std::vector<int> level(n, -1);
   for (bool changed = true; changed;) {  // parents may be numbered after their children
     changed = false;
@@ -176,14 +173,17 @@ inline std::vector<int> subdivision_levels(const HostMesh& m, int k) {
       changed = true;
     }
   }
-  std::vector<long long> count(k + 1, 0);
+  int depth = 0;
   for (const int l : level) {
-    if (l < 0 || l > k) return {};  // a cycle of parents, or deeper than the node count says
-    ++count[l];
+    if (l < 0 || l > 8) return {};  // a cycle of parents, or deeper than any mesh dcm makes
+    depth = std::max(depth, l);
   }
+  std::vector<long long> count(depth + 1, 0);
+  for (const int l : level) ++count[l];
+  if (count[0] != 12) return {};
   long long total = 0;
-  for (int j = 0; j <= k; ++j)
-    if ((total += count[j]) != icosphere_node_count(j)) return {};
+  for (int j = 0; j <= depth; ++j)
+    if ((total += count[j]) > icosphere_node_count(j)) return {};
   return level;
 }
 
@@ -198,14 +198,14 @@ inline HostHierarchy make_hierarchy(const std::vector<HostCell>& cells, int n_no
   int depth = 0;
   for (std::size_t c = 0; c < cells.size(); ++c) {
     const HostMesh& m = cells[c].mesh;
-    const int k = icosphere_level_of(m.nodes.size());
-    node_level[c] = subdivision_levels(m, k);
+    node_level[c] = subdivision_levels(m);
     if (node_level[c].empty()) {
       h.note = "cell " + std::to_string(c) + " (" + std::to_string(m.nodes.size()) +
                " nodes) has no icosphere subdivision hierarchy (HostMesh::parents): multigrid falls back to "
                "block-Jacobi";
       return h;
     }
+    const int k = *std::max_element(node_level[c].begin(), node_level[c].end());
     depth_of[c] = k;
     depth = std::max(depth, k);
   }

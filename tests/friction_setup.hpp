@@ -17,19 +17,20 @@ using Vector = FrictionOperator<Mem>::Vector;
 constexpr double kPi = 3.14159265358979323846;
 
 // Table 1: η = 0.8 mPa·s, r = 3.25 µm, c = 1.5e-6 N·s/m.
-// Cells of subdivision ks, randomly perturbed by up to 0.05 µm, 20 µm apart along x; each node's drag is
-// 6πηr / N_cell.
+// Cells of subdivision ks (each refined in `band`, core/band_refinement.cpp), randomly perturbed by up to
+// 0.05 µm, 20 µm apart along x; each node's drag is 6πηr / N_cell.
 struct FrictionSetup {
   std::vector<HostCell> cells;
   MeshBuffers<Mem> mesh;
   FrictionOperator<Mem> op;
   explicit FrictionSetup(int k, double c = 1.5e-6, unsigned seed = 7)
       : FrictionSetup(std::vector<int>{k}, c, seed) {}
-  explicit FrictionSetup(const std::vector<int>& ks, double c = 1.5e-6, unsigned seed = 7) {
+  explicit FrictionSetup(const std::vector<int>& ks, double c = 1.5e-6, unsigned seed = 7,
+                         const BandRefinement& band = {}) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(-0.05e-6, 0.05e-6);
     for (std::size_t n = 0; n < ks.size(); ++n) {
-      HostMesh m = make_icosphere(ks[n], 3.25e-6);
+      HostMesh m = make_icosphere(ks[n], 3.25e-6, band);
       for (auto& x : m.nodes)
         for (double& v : x) v += u(rng);
       translate(m, {20e-6 * static_cast<double>(n), 0, 0});

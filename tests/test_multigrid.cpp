@@ -44,7 +44,8 @@ Eigen::MatrixXd dense_blocks(const BlockCsr<Mem>& a) {
 struct Preconditioned : FrictionSetup {
   Multigrid<Mem> mg;
   RigidModes<Mem> rigid;
-  explicit Preconditioned(const std::vector<int>& ks) : FrictionSetup(ks), rigid(mesh.n_cells) {
+  explicit Preconditioned(const std::vector<int>& ks, const BandRefinement& band = {})
+      : FrictionSetup(ks, 1.5e-6, 7, band), rigid(mesh.n_cells) {
     mg = make_multigrid(cells, mesh);
     update_multigrid(Exec(), mesh, op, mg);
     update_rigid_modes(Exec(), mesh, op, rigid);
@@ -87,7 +88,7 @@ struct Preconditioned : FrictionSetup {
 TEST(Multigrid, IcosphereRecordsItsSubdivisionParents) {
   const HostMesh m = make_icosphere(3, 1.0);
   ASSERT_EQ(m.parents.size(), m.nodes.size());
-  const std::vector<int> level = subdivision_levels(m, 3);
+  const std::vector<int> level = subdivision_levels(m);
   ASSERT_EQ(level.size(), m.nodes.size());
   std::vector<int> count(4, 0);
   for (std::size_t i = 0; i < m.nodes.size(); ++i) {
@@ -110,7 +111,7 @@ TEST(Multigrid, IcosphereRecordsItsSubdivisionParents) {
   // Parents that do not describe a hierarchy: no levels (the multigrid falls back).
   HostMesh broken = m;
   broken.parents[100] = {-1, -1};  // a 13th level-0 node
-  EXPECT_TRUE(subdivision_levels(broken, 3).empty());
+  EXPECT_TRUE(subdivision_levels(broken).empty());
 }
 
 // The nodes are numbered for locality (core/host_mesh.cpp, renumber_in_bands): split into T equal contiguous
@@ -439,6 +440,29 @@ TEST(Multigrid, IterationsWellBelowBlockJacobi) {
     EXPECT_LE(4 * it[2], it[0]);
     EXPECT_LT(it[1], it[0]);
   }
+}
+
+// A band-refined icosphere (core/band_refinement.cpp) keeps its hierarchy: the first coarsenings thin the
+// band, then the icosphere's levels follow; the V-cycle stays symmetric and saves as many iterations.
+TEST(Multigrid, BandRefinedIcosphereKeepsTheMultigrid) {
+  const Preconditioned s({3}, {2, 60, 100});
+  ASSERT_TRUE(s.mg.available) << s.mg.note;
+  ASSERT_EQ(s.mg.levels.size(), 6u);        // depth 3 + 2
+  EXPECT_EQ(s.mg.levels[2].a.n_rows, 642);  // the icosphere of subdivision 3 once the band is gone
+  EXPECT_GT(s.mg.levels[1].a.n_rows, 642);
+  const Vector u = s.random_vector(11), w = s.random_vector(12);
+  const double wz = dot_host(to_host_vector(w), to_host_vector(s.vcycle(u)));
+  const double uz = dot_host(to_host_vector(u), to_host_vector(s.vcycle(w)));
+  EXPECT_NEAR(wz, uz, 1e-9 * std::fabs(wz));
+  EXPECT_GT(dot_host(to_host_vector(u), to_host_vector(s.vcycle(u))), 0.0);
+  const Vector f = s.random_vector(5, 1e-12);
+  Vector v_bj("v", s.mesh.n_nodes), v_mg("v", s.mesh.n_nodes);
+  const CgResult bj = s.solve(Preconditioned::Kind::block_jacobi, f, v_bj, 1e-6);
+  const CgResult mg = s.solve(Preconditioned::Kind::multigrid, f, v_mg, 1e-6);
+  ASSERT_TRUE(bj.converged && mg.converged);
+  std::printf("  %5d nodes (band-refined), 1e-6 relative: block-Jacobi %4d, multigrid %3d iterations\n",
+              s.mesh.n_nodes, bj.iterations, mg.iterations);
+  EXPECT_LE(4 * mg.iterations, bj.iterations);
 }
 
 TEST(Multigrid, RigidDeflationIsSymmetricAndPositive) {

@@ -78,7 +78,7 @@ void expect_same_values(const Scene& a, const Scene& b, const std::vector<std::s
 
 TEST(SceneSchema, KeysAreUniqueAndDefaultsLieInTheirRange) {
   const auto& schema = scene_schema();
-  ASSERT_EQ(schema.size(), 64u);
+  ASSERT_EQ(schema.size(), 67u);
   for (size_t i = 0; i < schema.size(); ++i) {
     for (size_t j = i + 1; j < schema.size(); ++j) EXPECT_NE(schema[i].key, schema[j].key);
     EXPECT_FALSE(schema[i].doc.empty()) << schema[i].key;
@@ -267,9 +267,10 @@ TEST(SceneParse, LevenshteinSuggestion) {
 TEST(SceneParse, UnknownKeyWithoutCloseMatchListsTheTable) {
   const std::string msg = string_error("[mesh]\ncompletely_different = 1\n");
   expect_one_line(msg);
-  EXPECT_TRUE(contains(msg,
-                       "t.toml: unknown key 'mesh.completely_different' (known keys in [mesh]: shape, "
-                       "subdivisions, nodes, radius_m, diameter_m)"))
+  EXPECT_TRUE(
+      contains(msg,
+               "t.toml: unknown key 'mesh.completely_different' (known keys in [mesh]: shape, "
+               "subdivisions, nodes, radius_m, diameter_m, refine_levels, refine_from_deg, refine_to_deg)"))
       << msg;
 }
 
@@ -479,6 +480,20 @@ TEST(SceneSet, FailedSetLeavesTheSceneUnchanged) {
 }
 
 // ---- cross-key validation ------------------------------------------------------------------------
+
+TEST(SceneValidate, RefinedBandEndsAboveItsStart) {
+  const std::string msg =
+      string_error("[mesh]\nrefine_levels = 2\nrefine_from_deg = 90\nrefine_to_deg = 80\n");
+  expect_one_line(msg);
+  EXPECT_EQ(msg,
+            "t.toml: mesh.refine_to_deg = 80 is not allowed: the refined band must end above "
+            "mesh.refine_from_deg = 90");
+  // Without refinement the band is not read.
+  Scene s = Scene::defaults();
+  s.set("mesh.refine_from_deg=90");
+  s.set("mesh.refine_to_deg=80");
+  EXPECT_NO_THROW(s.validate());
+}
 
 TEST(SceneValidate, H0BelowCellRadius) {
   const std::string msg = string_error("[contact]\nh0_m = 5e-7\n[mesh]\nradius_m = 4e-7\n");

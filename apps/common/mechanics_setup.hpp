@@ -73,12 +73,16 @@ inline MechanicsParams mechanics_from_scene(const Scene& scene) {
 // The cell's start shape (mesh.shape).
 inline HostMesh cell_mesh_from_scene(const Scene& scene) {
   const int k = static_cast<int>(scene.get_int("mesh.subdivisions"));
+  BandRefinement band;
+  band.levels = static_cast<int>(scene.get_int("mesh.refine_levels"));
+  band.from_deg = scene.get_real("mesh.refine_from_deg");
+  band.to_deg = scene.get_real("mesh.refine_to_deg");
   if (scene.get_string("mesh.shape") == "evans_fung") {
     EvansFungShape ef;
     ef.diameter = scene.get_real("mesh.diameter_m");
-    return make_evans_fung(k, ef);
+    return make_evans_fung(k, ef, band);
   }
-  return make_icosphere(k, scene.get_real("mesh.radius_m"));
+  return make_icosphere(k, scene.get_real("mesh.radius_m"), band);
 }
 
 // The time-step settings (time.*). dt_min ≤ dt ≤ dt_max is checked here (one line naming the keys).
