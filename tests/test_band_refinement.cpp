@@ -8,7 +8,9 @@
 #include <tuple>
 #include <vector>
 
+#include "core/host_copy.hpp"
 #include "core/host_mesh.hpp"
+#include "solvers/cortex_model.hpp"
 #include "solvers/multigrid_setup.hpp"
 
 namespace dcm {
@@ -136,6 +138,52 @@ TEST(BandRefinement, EvansFungTakesTheBandOfItsSphere) {
   const HostMesh m = make_evans_fung(3, {}, {2, 60, 120});
   EXPECT_GT(m.nodes.size(), plain.nodes.size());
   EXPECT_EQ(build_topology(m).euler_characteristic, 2);
+}
+
+// What refinement does to the cortex's moduli. Per-bond springs on a near-equilateral mesh give an energy per
+// area that does not depend on the edge length: under a uniform stretch of the whole cell by 2% the FENE+POW
+// bonds of the 10242-node icosphere store the 642-node one's energy per rest area to 0.01%, and so does the
+// 642-node one refined twice everywhere (a band of 0–180°: no border, no bisected triangles). Refined twice
+// in 60–100° it stores 3.0% more: the bisected (green) triangles at the borders of each level carry one bond
+// more than their area's share, so those rings are stiffer (docs/model/mesh_refinement.md); the test holds
+// the excess below 5%. The area terms are energies per area: on either mesh they add exactly
+// (k_a + k_d) (ΔA/A*)² / 2 per rest area to the bonds' energy. Bending stays zero (a uniform stretch keeps
+// every angle).
+TEST(BandRefinement, KeepsTheCortexModuli) {
+  using Exec = Kokkos::DefaultExecutionSpace;
+  const double r = 3.25e-6;
+  const auto stretched_energy_per_area = [&](const HostMesh& mesh, const MechanicsParams& p) {
+    CortexModel<Exec> model(Exec(), {HostCell(mesh)}, p);
+    auto x = Kokkos::create_mirror_view(model.positions());
+    for (std::size_t i = 0; i < mesh.nodes.size(); ++i)
+      for (int d = 0; d < 3; ++d) x(i, d) = 1.02 * mesh.nodes[i][d];
+    Kokkos::deep_copy(model.positions(), x);
+    return model.energy() / flat_area(mesh);
+  };
+  const HostMesh plain = make_icosphere(3, r), refined = make_icosphere(3, r, {2, 60, 100});
+  MechanicsParams bonds;
+  bonds.bonds = {3.2e-6, 2.05};
+  bonds.k_b = 240e-21;
+  const double e_plain = stretched_energy_per_area(plain, bonds);
+  const double e_refined = stretched_energy_per_area(refined, bonds);
+  const double e_fine = stretched_energy_per_area(make_icosphere(5, r), bonds);
+  const double e_everywhere = stretched_energy_per_area(make_icosphere(3, r, {2, 0, 180}), bonds);
+  std::printf(
+      "  2%% stretch, bonds' energy per rest area: %.5g J/m^2 on %zu nodes; %+.3f%% on 10242 nodes, %+.3f%% "
+      "refined twice everywhere, %+.2f%% refined twice in 60-100 deg (%zu nodes)\n",
+      e_plain, plain.nodes.size(), 100 * (e_fine / e_plain - 1), 100 * (e_everywhere / e_plain - 1),
+      100 * (e_refined / e_plain - 1), refined.nodes.size());
+  EXPECT_GT(e_plain, 0.0);
+  EXPECT_NEAR(e_fine / e_plain, 1.0, 1e-3);
+  EXPECT_NEAR(e_everywhere / e_plain, 1.0, 1e-3);
+  EXPECT_GT(e_refined / e_plain, 1.0);
+  EXPECT_LT(e_refined / e_plain, 1.05);
+  MechanicsParams area = bonds;
+  area.k_area_local = 6e-4;
+  area.k_area_global = 6e-3;
+  const double strain = 1.02 * 1.02 - 1, area_term = (6e-4 + 6e-3) * strain * strain / 2;
+  EXPECT_NEAR(stretched_energy_per_area(plain, area) - e_plain, area_term, 1e-9 * area_term);
+  EXPECT_NEAR(stretched_energy_per_area(refined, area) - e_refined, area_term, 1e-9 * area_term);
 }
 
 TEST(BandRefinement, RejectsBadBands) {
