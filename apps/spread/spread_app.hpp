@@ -88,7 +88,10 @@ double seconds_since(std::chrono::steady_clock::time_point t0);
 struct Progress {
   double step = 0, next_figure = 0, next_frame = 0, next_sample = 0, cg_total = 0, cg_max = 0;
   double worst_residual = 0, worst_residual_scale = 0, halved = 0, rejected = 0, h_min = INFINITY, h_max = 0;
-  double wall_before = 0;             // wall seconds of earlier segments of a restarted run
+  double wall_before = 0;  // wall seconds of earlier segments of a restarted run
+  // Adaptive steps kept at time.dt_min_s above the tolerance (StepReport::held_at_dt_min) and the largest
+  // error among them (m); in the checkpoint as app.held_at_dt_min since session 46, not in fields().
+  double held = 0, held_error_max = 0;
   std::array<double*, 13> fields() {  // in the checkpoint's app.progress order
     return {&step,   &next_figure,    &next_frame,           &next_sample, &cg_total,
             &cg_max, &worst_residual, &worst_residual_scale, &halved,      &rejected,

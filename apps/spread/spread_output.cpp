@@ -76,6 +76,7 @@ void write_checkpoint_now(Member& m, const Model& model, const Stepper& stepper,
   c.put("app.pending_row", m.stop_sample ? std::vector<double>{} : m.pending_row);
   c.put("app.contact_nodes", std::vector<double>{m.contact_nodes.most, m.contact_nodes.t, m.contact_nodes.r});
   c.put("app.h_last", m.h_last);
+  c.put("app.held_at_dt_min", std::vector<double>{m.p.held, m.p.held_error_max});
   if (m.onset_by_steps) c.put("app.contact_onset", m.onset.save());
   c.put("app.early_window_s", std::vector<double>{m.so.early_from_s, m.so.early_to_s});
   c.put("app.frames", m.h5 ? static_cast<double>(m.h5->frames()) : 0.0);
@@ -282,6 +283,17 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
         100 * (v_end / v_start - 1), k_v);
     warnings.emplace_back(text);
   }
+  // adaptive steps kept at time.dt_min_s above the tolerance: there the controller did not control the error
+  // (a dt_min set too high for the scene; session 46, from session 45's list of what deserves an issue);
+  if (p.held > 0) {
+    std::snprintf(text, sizeof text,
+                  "%.0f step(s) were kept at time.dt_min_s = %.3g s with the error estimate (largest %.3g m) "
+                  "above time.error_tol_m = %.3g m or the contact change above time.contact_change = %g: "
+                  "those steps do not meet the tolerance; lower time.dt_min_s",
+                  p.held, stepper.settings().dt_min, p.held_error_max, stepper.settings().error_tol_m,
+                  stepper.settings().contact_change);
+    warnings.emplace_back(text);
+  }
   // and a fixed-step run of a few steps (time.dt_s near t_end), which nothing above can judge.
   if (!stepper.settings().adaptive && done > 0 && done < 5 && !m.interrupted && !m.stopped_at_max_steps) {
     std::snprintf(
@@ -303,6 +315,7 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
       .add("t_end_s", t)
       .add("halved_steps", static_cast<long long>(p.halved))
       .add("rejected_steps", static_cast<long long>(p.rejected))
+      .add("steps_held_at_dt_min", static_cast<long long>(p.held))
       .add("adaptive", stepper.settings().adaptive)
       .add("dt_min_taken_s", std::isfinite(p.h_min) ? p.h_min : 0.0)
       .add("dt_max_taken_s", p.h_max)

@@ -94,6 +94,11 @@ void restore_from_checkpoint(Member& m, Model& model, Stepper& stepper) {
     m.contact_nodes.most = NAN;  // not known: the rows before the restart did not count them
   }
   if (c.arrays.count("app.h_last")) m.h_last = c.scalar("app.h_last");
+  if (c.arrays.count("app.held_at_dt_min")) {  // since session 46
+    const std::vector<double>& held = c.array("app.held_at_dt_min", 2);
+    m.p.held = held[0];
+    m.p.held_error_max = held[1];
+  }
   if (c.arrays.count("app.contact_onset")) {                      // since session 36
     const std::vector<double>& v = c.array("app.contact_onset");  // 5 values (sessions 36-37) or 8
     if (v.size() != 5 && v.size() != 8)
@@ -376,6 +381,10 @@ void account_step(std::vector<Member>& ms, Member& m, const StepReport& r, const
   p.cg_max = std::max(p.cg_max, static_cast<double>(r.iterations));
   p.halved += r.halvings;
   p.rejected += r.rejections;
+  if (r.held_at_dt_min) {
+    p.held += 1;
+    p.held_error_max = std::max(p.held_error_max, r.error_m);
+  }
   if (r.redone_h > 0) m.h_last = r.redone_h;  // this step took the one before it again, shorter
   if (m.h_last > 0) {
     p.h_min = std::min(p.h_min, m.h_last);
