@@ -95,9 +95,16 @@ void run(const AppOptions& options) {
   if (!options.quiet) {
     std::printf("dcm geometry: scene '%s' (%s)\n", scene.name().c_str(), scene.origin().c_str());
     std::printf("  %s\n", kokkos_description().c_str());
-    std::printf("  mesh         %s, %lld nodes (%lld subdivisions), %zu bonds, %zu triangles, %zu hinges\n",
-                shape.c_str(), nodes, scene.get_int("mesh.subdivisions"), topo.edges.size(),
+    char refined[96] = "";
+    if (scene.get_int("mesh.refine_levels") > 0)
+      std::snprintf(refined, sizeof refined, ", refined %lld levels in %g-%g deg",
+                    scene.get_int("mesh.refine_levels"), scene.get_real("mesh.refine_from_deg"),
+                    scene.get_real("mesh.refine_to_deg"));
+    std::printf("  mesh         %s, %lld nodes (%lld subdivisions%s), %zu bonds, %zu triangles, %zu hinges\n",
+                shape.c_str(), nodes, scene.get_int("mesh.subdivisions"), refined, topo.edges.size(),
                 hm.triangles.size(), topo.hinges.size());
+    std::printf("  worst angle  %.3g deg (smallest interior angle of any triangle)\n",
+                smallest_angle_deg(hm));
     std::printf("  topology     Euler characteristic %d, closed, consistently oriented\n",
                 topo.euler_characteristic);
     std::printf("  edge length  min %.4g  mean %.4g  max %.4g um\n", edge.min * 1e6, edge.mean() * 1e6,
@@ -136,6 +143,8 @@ void run(const AppOptions& options) {
       .add("nodes", nodes)
       .add("bonds", static_cast<long long>(topo.edges.size()))
       .add("triangles", static_cast<long long>(hm.triangles.size()))
+      .add("refine_levels", scene.get_int("mesh.refine_levels"))
+      .add("smallest_angle_deg", smallest_angle_deg(hm))
       .add("euler_characteristic", topo.euler_characteristic)
       .add("area_m2", area)
       .add("volume_m3", volume)
