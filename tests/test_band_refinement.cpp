@@ -70,8 +70,11 @@ TEST_P(BandRefinementCases, ClosedOrientedOnTheSphereAndFineInTheBand) {
   long long below = 0;
   for (int j = 0; j <= k + levels; ++j) {
     below += count[j];
-    if (j <= k) EXPECT_EQ(below, icosphere_node_count(j));
-    if (j > k) EXPECT_LE(below, icosphere_node_count(j));
+    if (j <= k) {
+      EXPECT_EQ(below, icosphere_node_count(j));
+    } else {
+      EXPECT_LE(below, icosphere_node_count(j));
+    }
   }
   for (const Vec3& x : m.nodes) EXPECT_NEAR(norm3(x), r, 1e-15 * r);
   for (const Tri& tr : m.triangles)
