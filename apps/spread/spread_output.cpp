@@ -288,10 +288,9 @@ void finish_member(Member& m, Model& model, const Stepper& stepper, NodeFields<E
   if (p.held > 0) {
     std::snprintf(text, sizeof text,
                   "%.0f step(s) were kept at time.dt_min_s = %.3g s with the error estimate (largest %.3g m) "
-                  "above time.error_tol_m = %.3g m or the contact change above time.contact_change = %g: "
-                  "those steps do not meet the tolerance; lower time.dt_min_s",
-                  p.held, stepper.settings().dt_min, p.held_error_max, stepper.settings().error_tol_m,
-                  stepper.settings().contact_change);
+                  "above time.error_tol_m = %.3g m: those steps do not meet the tolerance; lower "
+                  "time.dt_min_s",
+                  p.held, stepper.settings().dt_min, p.held_error_max, stepper.settings().error_tol_m);
     warnings.emplace_back(text);
   }
   // and a fixed-step run of a few steps (time.dt_s near t_end), which nothing above can judge.
