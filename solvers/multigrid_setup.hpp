@@ -175,7 +175,7 @@ inline std::vector<int> subdivision_levels(const HostMesh& m) {
   }
   int depth = 0;
   for (const int l : level) {
-    if (l < 0 || l > 8) return {};  // a cycle of parents, or deeper than any mesh dcm makes
+    if (l < 0 || l > 16) return {};  // a cycle of parents, or deeper than any mesh dcm makes
     depth = std::max(depth, l);
   }
   std::vector<long long> count(depth + 1, 0);

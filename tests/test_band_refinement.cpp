@@ -189,6 +189,23 @@ TEST(BandRefinement, KeepsTheCortexModuli) {
   EXPECT_NEAR(stretched_energy_per_area(refined, area) - e_refined, area_term, 1e-9 * area_term);
 }
 
+// The scene allows 6 subdivisions and 4 levels of refinement: hierarchies 10 deep keep the multigrid (the
+// first version gave up beyond 8, the icosphere's own limit). A chain of midpoints 12 levels deep on the
+// icosahedron's 12 nodes is a valid hierarchy; a 13th node without parents is not.
+TEST(BandRefinement, DeepHierarchiesKeepTheirLevels) {
+  HostMesh m = make_icosphere(0, 1.0);
+  for (int level = 1; level <= 12; ++level) {
+    const int a = static_cast<int>(m.nodes.size()) - 1, b = level == 1 ? 1 : 0;
+    m.nodes.push_back(m.nodes[b]);
+    m.parents.push_back({a, b});
+  }
+  const std::vector<int> level = subdivision_levels(m);
+  ASSERT_EQ(level.size(), m.nodes.size());
+  EXPECT_EQ(level.back(), 12);
+  m.parents.back() = {-1, -1};
+  EXPECT_TRUE(subdivision_levels(m).empty());
+}
+
 TEST(BandRefinement, RejectsBadBands) {
   EXPECT_THROW(make_icosphere(3, 1.0, {1, 100, 60}), std::invalid_argument);
   EXPECT_THROW(make_icosphere(3, 1.0, {1, -1, 60}), std::invalid_argument);
